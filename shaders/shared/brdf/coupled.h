@@ -1,0 +1,66 @@
+// coupled: Kelemen & Szirmay-Kalos 2001 coupled specular-matte model (docs/brdf-models.md 2.17):
+//   f_s = Fschlick(cb; f0) Dbeck(h; m) / (4 cb^2)
+//   f_m = rd (1 - a_s(theta_i)) (1 - a_s(theta_o)) / (pi (1 - abar_s))
+//   rd, f0: colour in [0, 1]; m in (0, 1].
+// The specular albedo a_s is linear in f0 (Schlick): a_s = f0 A1(theta) + A2(theta) with
+//   A1 = int (1 - (1 - cb)^5) D / (4 cb^2) co dw,  A2 = int (1 - cb)^5 D / (4 cb^2) co dw.
+// Both tables (COUPLED_TABLE_SIZE samples each, at cos theta = (j / (N - 1))^2, the first at
+// cos(89.999 deg), piecewise linear in sqrt(cos theta)) and their cosine-weighted averages
+// Abar1, Abar2 (computed from the interpolants, so the matte term integrates exactly to
+// rd (1 - a_s(theta_i))) live in the parameter block; the registry's packing computes them on the
+// CPU (src/brdf/albedo.cpp, coupledTables). No extra buffer is needed.
+#ifndef NUSSELT_BRDF_COUPLED_H
+#define NUSSELT_BRDF_COUPLED_H
+#include "common.h"
+SHARED_BEGIN
+
+#define COUPLED_RD 0u
+#define COUPLED_F0 3u
+#define COUPLED_M 6u
+#define COUPLED_ABAR1 7u
+#define COUPLED_ABAR2 8u
+#define COUPLED_TABLE1 9u
+#define COUPLED_TABLE2 20u
+#define COUPLED_TABLE_SIZE 11
+
+// Specular part (also used by the CPU to build the tables).
+SHARED_FN vec3 coupledSpecular(vec3 f0, float m, vec3 wi, vec3 wo) {
+  if (wi.z <= 0.0f || wo.z <= 0.0f) return vec3(0.0f);
+  vec3 h = brdfHalf(wi, wo);
+  float cb = max(dot(wi, h), 1e-7f);
+  return fresnelSchlick3(cb, f0) * (beckmannD(h, m) / (4.0f * cb * cb));
+}
+
+// Table abscissa of sample j: sqrt(cos theta).
+SHARED_FN float coupledTableX(int j) {
+  if (j == 0) return 0.0041791f;  // sqrt(cos(89.999 degrees))
+  return float(j) / float(COUPLED_TABLE_SIZE - 1);
+}
+
+// Interpolated table value at cosine c (offset = COUPLED_TABLE1 or COUPLED_TABLE2).
+SHARED_FN float coupledTable(BrdfParams p, uint offset, float c) {
+  float s = sqrt(clamp(c, 0.0f, 1.0f)) * float(COUPLED_TABLE_SIZE - 1);
+  int j = min(int(s), COUPLED_TABLE_SIZE - 2);
+  float x0 = coupledTableX(j);
+  float x1 = coupledTableX(j + 1);
+  float t = clamp((s / float(COUPLED_TABLE_SIZE - 1) - x0) / (x1 - x0), 0.0f, 1.0f);
+  return mix(brdfParam(p, offset + uint(j)), brdfParam(p, offset + uint(j) + 1u), t);
+}
+
+SHARED_FN vec3 coupledSpecularAlbedo(BrdfParams p, float c) {
+  return brdfParam3(p, COUPLED_F0) * coupledTable(p, COUPLED_TABLE1, c) + vec3(coupledTable(p, COUPLED_TABLE2, c));
+}
+
+SHARED_FN vec3 coupledEval(BrdfParams p, vec3 wi, vec3 wo) {
+  if (wi.z <= 0.0f || wo.z <= 0.0f) return vec3(0.0f);
+  vec3 f0 = brdfParam3(p, COUPLED_F0);
+  vec3 abar = f0 * brdfParam(p, COUPLED_ABAR1) + vec3(brdfParam(p, COUPLED_ABAR2));
+  vec3 ai = min(coupledSpecularAlbedo(p, wi.z), vec3(1.0f));
+  vec3 ao = min(coupledSpecularAlbedo(p, wo.z), vec3(1.0f));
+  vec3 matte = brdfParam3(p, COUPLED_RD) * (vec3(1.0f) - ai) * (vec3(1.0f) - ao) /
+               (NUSSELT_PI * max(vec3(1.0f) - abar, vec3(1e-6f)));
+  return coupledSpecular(f0, brdfParam(p, COUPLED_M), wi, wo) + matte;
+}
+
+SHARED_END
+#endif

@@ -1,0 +1,20 @@
+// minnaert: Minnaert 1941, normalised so that a(0) = rho (docs/brdf-models.md 2.10):
+//   f = rho (k + 1) / (2 pi) (ci co)^(k - 1);  a(theta_i) = rho cos^(k-1) theta_i.
+//   rho: colour in [0, 1]; k in [0.5, 2] (k < 1: unbounded at the rim, integrable).
+#ifndef NUSSELT_BRDF_MINNAERT_H
+#define NUSSELT_BRDF_MINNAERT_H
+#include "common.h"
+SHARED_BEGIN
+
+#define MINNAERT_RHO 0u
+#define MINNAERT_K 3u
+
+SHARED_FN vec3 minnaertEval(BrdfParams p, vec3 wi, vec3 wo) {
+  if (wi.z <= 0.0f || wo.z <= 0.0f) return vec3(0.0f);
+  float k = brdfParam(p, MINNAERT_K);
+  float s = (k + 1.0f) * (0.5f * NUSSELT_INV_PI) * exp((k - 1.0f) * (log(wi.z) + log(wo.z)));
+  return brdfParam3(p, MINNAERT_RHO) * s;
+}
+
+SHARED_END
+#endif

@@ -1,0 +1,207 @@
+// layout.h: every structure that crosses the CPU/GPU boundary, the bindings, the queue ids and
+// the wavefront stage names. Included by all compute stages and by the C++ driver: there is no
+// hand-written mirror of any struct (STYLE.md).
+#ifndef NUSSELT_LAYOUT_H
+#define NUSSELT_LAYOUT_H
+
+#include "prelude.h"
+
+SHARED_BEGIN
+
+// ---- Tunables (each with its why) ------------------------------------------------------------
+// Threads per workgroup: lavapipe ran light kernels 2-4x slower at 32 than at 64; real GPUs like 64.
+#define WORKGROUP_SIZE 64
+// Model slots: a render has one shade pipeline (and one shade queue) per reflectance model its
+// scene uses. 32 > the 20 models of the catalogue, room for measured BRDFs later.
+#define MAX_MODEL_SLOTS 32
+// Counters live at the head of the queue buffer; item arrays follow.
+#define QUEUE_HEADER_UINTS 64
+// Bounded BVH stack: depth of the tree is capped at build time to fit (src/scene/bvh.cpp).
+#define BVH_STACK_SIZE 64
+
+// ---- Queue ids --------------------------------------------------------------------------------
+// A queue is a count (queues[id]) plus path ids (queues[QUEUE_HEADER_UINTS + id * capacity + i]).
+// Ray queues ping-pong by bounce parity.
+#define QUEUE_RAY0 0u
+#define QUEUE_RAY1 1u
+#define QUEUE_SHADOW 2u
+#define QUEUE_SHADE_BASE 3u
+#define QUEUE_COUNT (QUEUE_SHADE_BASE + MAX_MODEL_SLOTS)
+
+// ---- Statistics counters (stats buffer, uint each) -----------------------------------------------
+#define STAT_NONFINITE_SAMPLES 0u   // samples dropped because L was NaN or Inf
+#define STAT_RAYS 1u                // extension rays traced
+#define STAT_SHADOW_RAYS 2u         // shadow rays traced
+#define STAT_BVH_STACK_OVERFLOW 3u  // traversals that ran out of stack (must stay 0)
+#define STAT_SAMPLER_BOUND_VIOLATIONS 4u
+#define STAT_SAMPLER_TRIAL_FAILURES 5u
+#define STAT_COUNT 16u
+
+// ---- Light types ----------------------------------------------------------------------------------
+#define LIGHT_TRIANGLE 0u
+#define LIGHT_POINT 1u
+#define LIGHT_SPOT 2u
+#define LIGHT_DIRECTIONAL 3u
+
+// ---- Light-sampling modes (Globals.counts.w): MIS by default; the others exist for tests ----------
+#define LIGHTING_MIS 0u
+#define LIGHTING_NEE_ONLY 1u
+#define LIGHTING_BSDF_ONLY 2u
+
+// ---- Material flags ---------------------------------------------------------------------------------
+#define MATERIAL_EMISSIVE 1u
+#define MATERIAL_DELTA 2u
+
+// Invalid index marker.
+#define INVALID_INDEX 0xffffffffu
+
+// ---- Structures ---------------------------------------------------------------------------------
+
+// A BVH node stores the boxes of both children (the fastest layout measured on lavapipe).
+// link = (child0, child1, count0, count1): count > 0 means the child is a leaf holding
+// triangles [child, child + count); count == 0 means child is an inner node index.
+struct BvhNode {
+  vec4 min0;
+  vec4 max0;
+  vec4 min1;
+  vec4 max1;
+  uvec4 link;
+};
+STATIC_ASSERT_SIZE(BvhNode, 80);
+
+// Intersection data of one triangle, in world space: v0 and two edges (Moller-Trumbore).
+struct GpuTriangle {
+  vec4 v0;
+  vec4 e1;
+  vec4 e2;
+};
+STATIC_ASSERT_SIZE(GpuTriangle, 48);
+
+// Shading data of one triangle: vertex normals (world space, w unused) and
+// info = (material index, emitter light index or INVALID_INDEX, 0, 0).
+struct GpuTriShading {
+  vec4 n0;
+  vec4 n1;
+  vec4 n2;
+  uvec4 info;
+};
+STATIC_ASSERT_SIZE(GpuTriShading, 64);
+
+// The parameter block of a reflectance model: 32 floats, read with brdfParam(p, i).
+// Colours take three consecutive floats. The meaning of each index is defined once, in the
+// model's shared header (shaders/shared/brdf/<model>.h) and its registry entry.
+#define BRDF_PARAM_VEC4S 8
+struct BrdfParams {
+  vec4 v[BRDF_PARAM_VEC4S];
+};
+STATIC_ASSERT_SIZE(BrdfParams, 128);
+
+// info = (model id, MATERIAL_* flags, table offset for models that need one, 0).
+// emission = emitted radiance (rgb), w unused.
+struct GpuMaterial {
+  uvec4 info;
+  vec4 emission;
+  BrdfParams params;
+};
+STATIC_ASSERT_SIZE(GpuMaterial, 160);
+
+// A light. Triangle emitters: info = (LIGHT_TRIANGLE, triangle index, 0, 0), radiance from the
+// material. Punctual lights (KHR_lights_punctual): position (w unused), direction the light
+// points to (unit), radiance = intensity (W/sr; irradiance W/m^2 for directional),
+// cone = (cos inner, cos outer, 0, 0).
+struct GpuLight {
+  uvec4 info;
+  vec4 position;
+  vec4 direction;
+  vec4 intensity;
+  vec4 cone;
+};
+STATIC_ASSERT_SIZE(GpuLight, 80);
+
+// Indirect dispatch arguments for one queue (x, y, z, pad): matches VkDispatchIndirectCommand
+// at a 16-byte stride.
+struct DispatchArgs {
+  uvec4 groups;
+};
+STATIC_ASSERT_SIZE(DispatchArgs, 16);
+
+#ifdef __cplusplus
+#define BUFREF(T) std::uint64_t
+#else
+#define BUFREF(T) T
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer BvhNodes { BvhNode v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Triangles { GpuTriangle v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer TriShadings { GpuTriShading v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Materials { GpuMaterial v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Lights { GpuLight v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Vec4s { vec4 v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer UVec4s { uvec4 v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer Floats { float v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer Uints { uint v[]; };
+#endif
+
+// Per-render constants and the addresses of every buffer (buffer device addresses: no storage
+// buffer binding limits the size of a scene; lavapipe caps one binding at 128 MiB).
+struct Globals {
+  uvec4 image;      // width, height, first pixel of this chunk, pixels in this chunk
+  uvec4 frame;      // sample index of this pass, seed, max depth, path capacity
+  uvec4 counts;     // materials, lights, triangles, lighting mode (LIGHTING_*)
+  vec4 camPosition; // xyz, w = 1 for orthographic
+  vec4 camRight;    // unit right * (tan(yfov/2) * aspect), or * xmag for orthographic
+  vec4 camUp;       // unit up * tan(yfov/2), or * ymag for orthographic
+  vec4 camForward;  // unit view direction
+  vec4 sceneSphere; // bounding sphere of the scene: centre, radius (directional lights)
+  vec4 lightTotal;  // x = sum of light selection weights
+  vec4 background;  // radiance of rays that escape the scene (rgb)
+
+  BUFREF(BvhNodes) bvh;
+  BUFREF(Triangles) triangles;
+  BUFREF(TriShadings) shading;
+  BUFREF(Materials) materials;
+  BUFREF(Lights) lights;
+  BUFREF(Floats) lightCdf;     // lightCount + 1 entries, cdf[0] = 0, cdf[n] = 1
+  BUFREF(Vec4s) film;          // per pixel: sum of samples (rgb), w = samples taken
+  BUFREF(Vec4s) filmSq;        // per pixel: sum of squared samples (rgb)
+  BUFREF(Vec4s) pathOrigin;    // per path: ray origin
+  BUFREF(Vec4s) pathDirection; // per path: ray direction, w = pdf of the BSDF sample (0: delta/camera)
+  BUFREF(Vec4s) pathThroughput;// per path: throughput (rgb)
+  BUFREF(Vec4s) pathRadiance;  // per path: radiance gathered so far (rgb)
+  BUFREF(UVec4s) pathInfo;     // per path: (pixel, flags, 0, 0)
+  BUFREF(Vec4s) pathHit;       // per path: (t, b1, b2, triangle bits)
+  BUFREF(Vec4s) shadowOrigin;  // per path: shadow ray origin, w = tmax
+  BUFREF(Vec4s) shadowDirection;
+  BUFREF(Vec4s) shadowRadiance;// per path: contribution if unoccluded
+  BUFREF(Uints) queues;        // QUEUE_HEADER_UINTS counters, then QUEUE_COUNT item arrays
+  BUFREF(UVec4s) dispatchArgs; // QUEUE_COUNT DispatchArgs
+  BUFREF(Uints) stats;         // STAT_COUNT counters
+  BUFREF(Floats) tables;       // model tables (albedo tables, quadtrees) addressed by offsets
+  BUFREF(Uints) pad0;
+};
+STATIC_ASSERT_SIZE(Globals, 48 + 7 * 16 + 22 * 8);
+
+// Push constants of every stage.
+struct StageConstants {
+  uint bounce;     // current bounce (0 = camera ray)
+  uint modelSlot;  // shade stage: which shade queue to consume
+  uint queueA;     // submit stage: queue whose dispatch args to write (or INVALID_INDEX)
+  uint queueB;     // submit stage: first queue to zero
+  uint queueBCount;// submit stage: number of consecutive queues to zero
+  uint queueC;     // submit stage: first of a range of queues whose args to write
+  uint queueCCount;
+  uint pad;
+};
+STATIC_ASSERT_SIZE(StageConstants, 32);
+
+#ifndef __cplusplus
+layout(set = 0, binding = 0, std430) readonly buffer GlobalsBlock { Globals g; };
+layout(push_constant, std430) uniform PushBlock { StageConstants pc; };
+#endif
+
+SHARED_FN float brdfParam(BrdfParams p, uint i) { return p.v[i / 4u][i % 4u]; }
+SHARED_FN vec3 brdfParam3(BrdfParams p, uint i) {
+  return vec3(brdfParam(p, i), brdfParam(p, i + 1u), brdfParam(p, i + 2u));
+}
+
+SHARED_END
+
+#endif

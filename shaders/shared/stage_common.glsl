@@ -1,0 +1,145 @@
+// stage_common.glsl: what every wavefront stage shares (GLSL only): extensions, the globals,
+// queues, ray offsets and light sampling. Included first by each shaders/stages/*.comp.
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_scalar_block_layout : require
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_ballot : require
+
+#include "shared/layout.h"
+#include "shared/rng.h"
+#include "shared/warp.h"
+#include "shared/bvh_traverse.glsl"
+
+layout(local_size_x = WORKGROUP_SIZE) in;
+
+// ---- Queues ---------------------------------------------------------------------------------
+
+uint queueCount(uint queue) { return g.queues.v[queue]; }
+
+uint queueItem(uint queue, uint i) { return g.queues.v[QUEUE_HEADER_UINTS + queue * g.frame.w + i]; }
+
+// Push a path id. One atomic per subgroup (lavapipe: halves the cost of a per-lane atomic).
+void queuePush(uint queue, uint path) {
+  uvec4 ballot = subgroupBallot(true);
+  uint n = subgroupBallotBitCount(ballot);
+  uint rank = subgroupBallotExclusiveBitCount(ballot);
+  uint base = 0u;
+  if (subgroupElect()) base = atomicAdd(g.queues.v[queue], n);
+  base = subgroupBroadcastFirst(base);
+  g.queues.v[QUEUE_HEADER_UINTS + queue * g.frame.w + base + rank] = path;
+}
+
+// ---- Rays -----------------------------------------------------------------------------------
+
+// Move a ray origin off a surface along its geometric normal n by a few ulps of the position:
+// scale-invariant, so scenes from 1e-4 to 1e6 units work (Waechter and Binder, "A Fast and
+// Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, ch. 6, 2019).
+vec3 offsetRay(vec3 p, vec3 n) {
+  const float origin = 1.0f / 32.0f;
+  const float floatScale = 1.0f / 65536.0f;
+  const float intScale = 256.0f;
+  ivec3 of = ivec3(intScale * n.x, intScale * n.y, intScale * n.z);
+  vec3 pi = vec3(intBitsToFloat(floatBitsToInt(p.x) + ((p.x < 0.0f) ? -of.x : of.x)),
+                 intBitsToFloat(floatBitsToInt(p.y) + ((p.y < 0.0f) ? -of.y : of.y)),
+                 intBitsToFloat(floatBitsToInt(p.z) + ((p.z < 0.0f) ? -of.z : of.z)));
+  return vec3(abs(p.x) < origin ? p.x + floatScale * n.x : pi.x,
+              abs(p.y) < origin ? p.y + floatScale * n.y : pi.y,
+              abs(p.z) < origin ? p.z + floatScale * n.z : pi.z);
+}
+
+// ---- Triangles ------------------------------------------------------------------------------
+
+vec3 triangleNormalUnnormalized(uint tri) {
+  GpuTriangle t = g.triangles.v[tri];
+  return cross(t.e1.xyz, t.e2.xyz);
+}
+
+// ---- Lights ---------------------------------------------------------------------------------
+
+// Probability of selecting light i (the CDF is proportional to estimated power).
+float lightSelectPdf(uint i) { return g.lightCdf.v[i + 1u] - g.lightCdf.v[i]; }
+
+// Light index for u in [0, 1): binary search over the CDF (at most 32 iterations).
+uint selectLight(float u) {
+  uint lo = 0u;
+  uint hi = g.counts.y;  // cdf has counts.y + 1 entries
+  for (int it = 0; it < 32 && lo + 1u < hi; ++it) {
+    uint mid = (lo + hi) / 2u;
+    if (g.lightCdf.v[mid] <= u) lo = mid; else hi = mid;
+  }
+  return lo;
+}
+
+// Solid-angle pdf with which light sampling would have chosen the point hit at distance t on
+// emitting triangle tri seen under cosLight (> 0); used for MIS when a BSDF ray hits an emitter.
+float triangleLightPdf(uint lightIndex, uint tri, float t, float cosLight) {
+  float area = 0.5f * length(triangleNormalUnnormalized(tri));
+  return lightSelectPdf(lightIndex) * t * t / max(area * cosLight, 1e-30f);
+}
+
+// A light sample seen from point x: direction wi (unit, world), distance (inf for directional),
+// the radiance or irradiance it carries divided by its pdf, and the solid-angle pdf (0 for
+// punctual lights, which no BSDF sample can hit).
+struct LightSample {
+  vec3 wi;
+  float dist;
+  vec3 value;   // Le / pdf (area lights) or I / r^2 / pSelect (punctual)
+  float pdf;    // solid angle, including the selection probability; 0: delta light
+};
+
+bool sampleLight(vec3 x, float uSelect, vec2 uPoint, out LightSample ls) {
+  ls.wi = vec3(0.0f);
+  ls.dist = 0.0f;
+  ls.value = vec3(0.0f);
+  ls.pdf = 0.0f;
+  if (g.counts.y == 0u) return false;
+  uint li = selectLight(uSelect);
+  float pSelect = lightSelectPdf(li);
+  if (pSelect <= 0.0f) return false;
+  GpuLight light = g.lights.v[li];
+  uint type = light.info.x;
+  if (type == LIGHT_TRIANGLE) {
+    uint tri = light.info.y;
+    GpuTriangle t = g.triangles.v[tri];
+    vec2 b = squareToTriangle(uPoint);
+    vec3 y = t.v0.xyz + b.x * t.e1.xyz + b.y * t.e2.xyz;
+    vec3 nu = cross(t.e1.xyz, t.e2.xyz);
+    float area2 = length(nu);
+    vec3 ny = nu / area2;
+    vec3 d = y - x;
+    float dist2 = dot(d, d);
+    if (dist2 <= 0.0f) return false;
+    float dist = sqrt(dist2);
+    ls.wi = d / dist;
+    float cosLight = -dot(ls.wi, ny);   // emitters radiate on their front side only
+    if (cosLight <= 0.0f) return false;
+    ls.pdf = pSelect * dist2 / (0.5f * area2 * cosLight);
+    uint material = g.shading.v[tri].info.x;
+    ls.value = g.materials.v[material].emission.xyz / ls.pdf;
+    ls.dist = dist;
+    return ls.pdf > 0.0f && isFinite(ls.pdf);
+  }
+  if (type == LIGHT_DIRECTIONAL) {
+    ls.wi = -light.direction.xyz;
+    ls.dist = 3.0e38f;
+    ls.value = light.intensity.xyz / pSelect;
+    return true;
+  }
+  // point and spot
+  vec3 d = light.position.xyz - x;
+  float dist2 = dot(d, d);
+  if (dist2 <= 0.0f) return false;
+  ls.dist = sqrt(dist2);
+  ls.wi = d / ls.dist;
+  float falloff = 1.0f;
+  if (type == LIGHT_SPOT) {
+    // glTF KHR_lights_punctual's suggested smooth cone attenuation.
+    float cd = dot(-ls.wi, light.direction.xyz);
+    float cosInner = light.cone.x;
+    float cosOuter = light.cone.y;
+    float s = clamp((cd - cosOuter) / max(cosInner - cosOuter, 1e-4f), 0.0f, 1.0f);
+    falloff = s * s;
+  }
+  ls.value = light.intensity.xyz * (falloff / (dist2 * pSelect));
+  return falloff > 0.0f;
+}

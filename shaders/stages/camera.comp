@@ -1,0 +1,37 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// camera: one primary ray per pixel of this chunk; initialises the path state and fills ray
+// queue 0 with every path (path i <-> pixel chunkStart + i).
+#include "shared/stage_common.glsl"
+
+void main() {
+  uint i = gl_GlobalInvocationID.x;
+  if (i >= g.image.w) return;
+  uint pixel = g.image.z + i;
+  uint width = g.image.x;
+  uint px = pixel % width;
+  uint py = pixel / width;
+
+  // Pixel jitter: dimensions 0 and 1 (box filter over the pixel).
+  vec2 u = rng2(pixel, g.frame.x, 0u, g.frame.y);
+  float sx = ((float(px) + u.x) / float(width)) * 2.0f - 1.0f;
+  float sy = 1.0f - ((float(py) + u.y) / float(g.image.y)) * 2.0f;
+
+  vec3 origin;
+  vec3 dir;
+  if (g.camPosition.w > 0.5f) {  // orthographic
+    origin = g.camPosition.xyz + sx * g.camRight.xyz + sy * g.camUp.xyz;
+    dir = g.camForward.xyz;
+  } else {
+    origin = g.camPosition.xyz;
+    dir = normalize(g.camForward.xyz + sx * g.camRight.xyz + sy * g.camUp.xyz);
+  }
+
+  g.pathOrigin.v[i] = vec4(origin, 0.0f);
+  g.pathDirection.v[i] = vec4(dir, 0.0f);  // w = 0: no BSDF pdf yet (camera ray)
+  g.pathThroughput.v[i] = vec4(1.0f, 1.0f, 1.0f, 0.0f);
+  g.pathRadiance.v[i] = vec4(0.0f);
+  g.pathInfo.v[i] = uvec4(pixel, 0u, 0u, 0u);
+  g.queues.v[QUEUE_HEADER_UINTS + QUEUE_RAY0 * g.frame.w + i] = i;
+  if (i == 0u) g.queues.v[QUEUE_RAY0] = g.image.w;
+}

@@ -1,0 +1,28 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// intersect: closest hit for every path in the current ray queue. Hits go to the shade queue of
+// their material's model; escaping rays pick up the background and end.
+#include "shared/stage_common.glsl"
+
+void main() {
+  uint queue = pc.bounce & 1u;
+  uint idx = gl_GlobalInvocationID.x;
+  if (idx >= queueCount(queue)) return;
+  uint path = queueItem(queue, idx);
+
+  vec3 o = g.pathOrigin.v[path].xyz;
+  vec3 d = g.pathDirection.v[path].xyz;
+  float t;
+  float b1;
+  float b2;
+  uint tri;
+  if (traceClosest(o, d, 0.0f, 3.0e38f, t, b1, b2, tri)) {
+    g.pathHit.v[path] = vec4(t, b1, b2, uintBitsToFloat(tri));
+    uint material = g.shading.v[tri].info.x;
+    queuePush(QUEUE_SHADE_BASE + g.materials.v[material].info.w, path);
+  } else {
+    // Escape: the background is not light-sampled, so its weight is 1.
+    vec3 beta = g.pathThroughput.v[path].xyz;
+    g.pathRadiance.v[path].xyz += beta * g.background.xyz;
+  }
+}

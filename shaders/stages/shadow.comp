@@ -1,0 +1,13 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// shadow: any-hit test of each queued shadow ray; unoccluded ones add their contribution.
+#include "shared/stage_common.glsl"
+
+void main() {
+  uint idx = gl_GlobalInvocationID.x;
+  if (idx >= queueCount(QUEUE_SHADOW)) return;
+  uint path = queueItem(QUEUE_SHADOW, idx);
+  vec4 o = g.shadowOrigin.v[path];
+  vec3 d = g.shadowDirection.v[path].xyz;
+  if (!traceAny(o.xyz, d, 0.0f, o.w)) g.pathRadiance.v[path].xyz += g.shadowRadiance.v[path].xyz;
+}

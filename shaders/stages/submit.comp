@@ -1,0 +1,21 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// submit: one small workgroup between stages. Turns queue counts into indirect dispatch sizes
+// (count -> ceil(count / WORKGROUP_SIZE) groups), tallies traced rays, and empties the queues
+// the previous stage consumed (zeux/niagara's tasksubmit pattern).
+#include "shared/stage_common.glsl"
+
+void writeArgs(uint queue) {
+  uint count = g.queues.v[queue];
+  g.dispatchArgs.v[queue] = uvec4((count + WORKGROUP_SIZE - 1u) / WORKGROUP_SIZE, 1u, 1u, 0u);
+  if (queue == QUEUE_RAY0 || queue == QUEUE_RAY1) atomicAdd(g.stats.v[STAT_RAYS], count);
+  if (queue == QUEUE_SHADOW) atomicAdd(g.stats.v[STAT_SHADOW_RAYS], count);
+}
+
+void main() {
+  uint t = gl_LocalInvocationID.x;
+  if (t == 0u && pc.queueA != INVALID_INDEX) writeArgs(pc.queueA);
+  for (uint q = t; q < pc.queueCCount; q += WORKGROUP_SIZE) writeArgs(pc.queueC + q);
+  // Zero after reading: the zeroed range never overlaps the ranges read above.
+  for (uint q = t; q < pc.queueBCount; q += WORKGROUP_SIZE) g.queues.v[pc.queueB + q] = 0u;
+}

@@ -1,0 +1,322 @@
+// commands.cpp: the command line: render, devices, bench render.
+#include "cli/commands.h"
+
+#include <CLI/CLI.hpp>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+
+#include "io/image.h"
+#include "render/renderer.h"
+#include "scene/gltf_loader.h"
+#include "util/error.h"
+#include "util/progress.h"
+#include "vk/vk.h"
+
+namespace nusselt {
+extern const unsigned char kDefaultSceneBytes[];
+extern const std::size_t kDefaultSceneSize;
+
+namespace {
+
+std::atomic<int> g_stopSignal{0};
+
+void onSignal(int sig) {
+  g_stopSignal.store(sig);
+  // A second signal ends the program at once.
+  std::signal(sig, SIG_DFL);
+}
+
+bool validationFromEnvironment() {
+  const char* v = std::getenv("NUSSELT_VALIDATION");
+  return v && *v && std::string(v) != "0";
+}
+
+// Checks that `path` can be written (its directory exists and is writable) before any work.
+void checkOutputPath(const std::string& path, const std::string& option) {
+  namespace fs = std::filesystem;
+  fs::path p(path);
+  fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw Error(option + " " + path + ": directory " + dir.string() + " does not exist");
+  if (fs::is_directory(p, ec)) throw Error(option + " " + path + ": is a directory");
+  if (access(dir.c_str(), W_OK) != 0) throw Error(option + " " + path + ": directory " + dir.string() + " is not writable");
+}
+
+Scene loadSceneOrDefault(const std::string& path, const std::string& camera) {
+  LoadOptions opts;
+  opts.cameraName = camera;
+  if (path.empty()) return loadSceneFromMemory(kDefaultSceneBytes, kDefaultSceneSize, "default scene (cornell-box.glb)", opts);
+  return loadScene(path, opts);
+}
+
+void printSceneWarnings(const Scene& scene, bool quiet) {
+  if (quiet) return;
+  for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  if (scene.droppedTriangles)
+    std::fprintf(stderr, "warning: %s: dropped %llu degenerate triangles (zero area or non-finite vertices)\n",
+                 scene.sourcePath.c_str(), static_cast<unsigned long long>(scene.droppedTriangles));
+}
+
+struct RenderArgs {
+  std::string scene;
+  std::string output = "render.exr";
+  std::string png;
+  std::string camera;
+  std::uint32_t spp = 64;
+  std::uint32_t width = 0, height = 0;
+  std::uint32_t seed = 0;
+  std::uint32_t maxDepth = 8;
+  int device = -1;
+  std::string lighting = "mis";
+  bool variance = false;
+  bool validation = false;
+  bool quiet = false;
+  float exposure = 0.0f;
+};
+
+int renderCommand(const RenderArgs& a) {
+  if (a.spp == 0) throw Error("--spp 0: at least one sample per pixel is needed");
+  checkOutputPath(a.output, "-o");
+  if (!a.png.empty()) checkOutputPath(a.png, "--png");
+
+  Scene scene = loadSceneOrDefault(a.scene, a.camera);
+  printSceneWarnings(scene, a.quiet);
+
+  RenderSettings s;
+  s.spp = a.spp;
+  s.seed = a.seed;
+  s.maxDepth = a.maxDepth;
+  s.lighting = a.lighting == "nee" ? LightingMode::NeeOnly : a.lighting == "bsdf" ? LightingMode::BsdfOnly : LightingMode::Mis;
+  // Image size: defaults follow the camera's aspect ratio when only one side (or none) is given.
+  float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
+  s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u);
+  s.height = a.height ? a.height : std::max(1u, unsigned(s.width / aspect + 0.5f));
+
+  vk::Context ctx;
+  vk::ContextOptions co;
+  co.deviceIndex = a.device;
+  co.validation = a.validation || validationFromEnvironment();
+  vk::createContext(ctx, co);
+  int status = kExitOk;
+  {
+    auto t0 = std::chrono::steady_clock::now();
+    Renderer renderer(ctx, scene, s);
+    const SceneSummary& sum = renderer.summary();
+    if (!a.quiet) {
+      std::string models;
+      for (auto& m : sum.models) models += (models.empty() ? "" : ",") + m;
+      std::fprintf(stderr, "scene: %s: %zu triangles, %zu materials (models: %s), %zu lights; BVH %u nodes in %.3f s\n",
+                   scene.sourcePath.c_str(), sum.triangles, sum.materials, models.c_str(), sum.lights, sum.bvhNodes,
+                   sum.bvhSeconds);
+      std::fprintf(stderr, "device: %s; %ux%u, %u spp, max depth %u, seed %u, lighting %s\n", ctx.deviceName.c_str(),
+                   s.width, s.height, s.spp, s.maxDepth, s.seed, lightingModeName(s.lighting));
+    }
+
+    g_stopSignal = 0;
+    auto oldInt = std::signal(SIGINT, onSignal);
+    auto oldTerm = std::signal(SIGTERM, onSignal);
+    auto tRender = std::chrono::steady_clock::now();
+    {
+      Progress progress("render", s.spp, std::uint64_t(s.width) * s.height, false, a.quiet);
+      while (renderer.samplesDone() < s.spp && g_stopSignal == 0) {
+        renderer.renderPass();
+        progress.update(renderer.samplesDone());
+      }
+      RenderStats st = renderer.stats();
+      char extra[256];
+      std::snprintf(extra, sizeof extra, "%.2f Mrays/s", (st.rays + st.shadowRays) / 1e6 /
+                                                              std::max(1e-9, std::chrono::duration<double>(std::chrono::steady_clock::now() - tRender).count()));
+      progress.finish(extra);
+    }
+    std::signal(SIGINT, oldInt);
+    std::signal(SIGTERM, oldTerm);
+    double renderSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tRender).count();
+    double totalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    RenderStats st = renderer.stats();
+    const bool interrupted = g_stopSignal != 0;
+    if (interrupted)
+      std::fprintf(stderr, "interrupted by %s after %u of %u spp: writing what has accumulated\n",
+                   g_stopSignal == SIGINT ? "SIGINT" : "SIGTERM", renderer.samplesDone(), s.spp);
+
+    if (renderer.samplesDone() > 0) {
+      Image img = renderer.image(a.variance);
+      ImageMetadata meta;
+      meta.strings = {{"nusselt/version", NUSSELT_VERSION},
+                      {"nusselt/scene", scene.sourcePath},
+                      {"nusselt/device", ctx.deviceName},
+                      {"nusselt/integrator", "wavefront path tracer: NEE + BSDF sampling, MIS power heuristic, "
+                                             "albedo Russian roulette"},
+                      {"nusselt/lighting", lightingModeName(s.lighting)},
+                      {"nusselt/sampler", "cosine"},
+                      {"nusselt/models", [&] { std::string m; for (auto& x : renderer.summary().models) m += (m.empty() ? "" : ",") + x; return m; }()}};
+      meta.ints = {{"nusselt/spp", renderer.samplesDone()},
+                   {"nusselt/sppRequested", s.spp},
+                   {"nusselt/seed", s.seed},
+                   {"nusselt/maxDepth", s.maxDepth},
+                   {"nusselt/interrupted", interrupted ? 1 : 0},
+                   {"nusselt/nonFiniteSamples", static_cast<std::int64_t>(st.nonFiniteSamples)},
+                   {"nusselt/samplerBoundViolations", static_cast<std::int64_t>(st.samplerBoundViolations)},
+                   {"nusselt/samplerTrialFailures", static_cast<std::int64_t>(st.samplerTrialFailures)},
+                   {"nusselt/droppedTriangles", static_cast<std::int64_t>(scene.droppedTriangles)}};
+      meta.doubles = {{"nusselt/renderSeconds", renderSeconds}, {"nusselt/totalSeconds", totalSeconds}};
+      writeExr(a.output, img, meta);
+      if (!a.png.empty()) writePng(a.png, img, a.exposure);
+      if (!a.quiet) {
+        std::fprintf(stderr, "wrote %s (%u spp)%s%s\n", a.output.c_str(), renderer.samplesDone(),
+                     a.png.empty() ? "" : " and ", a.png.c_str());
+        if (st.nonFiniteSamples)
+          std::fprintf(stderr, "warning: %llu non-finite samples were dropped\n",
+                       static_cast<unsigned long long>(st.nonFiniteSamples));
+        if (st.bvhStackOverflows)
+          std::fprintf(stderr, "warning: %llu BVH traversals overflowed their stack\n",
+                       static_cast<unsigned long long>(st.bvhStackOverflows));
+      }
+    } else {
+      std::fprintf(stderr, "no sample was completed: nothing written\n");
+    }
+    if (interrupted) status = kExitInterrupted;
+  }
+  std::uint64_t messages = ctx.validationMessages.load();
+  vk::destroyContext(ctx);
+  if (messages) {
+    std::fprintf(stderr, "error: %llu Vulkan validation messages\n", static_cast<unsigned long long>(messages));
+    if (status == kExitOk) status = kExitFailure;
+  }
+  return status;
+}
+
+int devicesCommand() {
+  auto devices = vk::listDevices();
+  if (devices.empty()) {
+    std::printf("no Vulkan devices (install mesa-vulkan-drivers for lavapipe, or your GPU's driver)\n");
+    return kExitFailure;
+  }
+  for (const auto& d : devices)
+    std::printf("%u: %s (%s, Vulkan %u.%u, %.0f MiB device-local)%s%s\n", d.index, d.name.c_str(), d.type.c_str(),
+                VK_API_VERSION_MAJOR(d.apiVersion), VK_API_VERSION_MINOR(d.apiVersion),
+                d.deviceLocalBytes / 1048576.0, d.suitable ? "" : ": not usable: ", d.whyNot.c_str());
+  return kExitOk;
+}
+
+struct BenchArgs {
+  std::vector<std::string> scenes;
+  std::uint32_t spp = 4;
+  std::uint32_t width = 256, height = 256;
+  int device = -1;
+};
+
+int benchRenderCommand(const BenchArgs& a) {
+  std::vector<std::string> scenes = a.scenes;
+  if (scenes.empty()) {
+    scenes.push_back("");
+    std::string dragon = std::string(NUSSELT_SCENES_DIR) + "/dragon/dragon.gltf";
+    if (std::filesystem::exists(dragon)) scenes.push_back(dragon);
+    else std::fprintf(stderr, "note: %s not found; benchmarking the default scene only\n", dragon.c_str());
+  }
+  vk::Context ctx;
+  vk::ContextOptions co;
+  co.deviceIndex = a.device;
+  vk::createContext(ctx, co);
+  std::printf("device: %s\n", ctx.deviceName.c_str());
+  std::printf("%-40s %10s %9s %8s %10s %12s %12s\n", "scene", "triangles", "size", "spp", "seconds", "samples/s",
+              "Mrays/s");
+  for (const std::string& path : scenes) {
+    Scene scene = loadSceneOrDefault(path, "");
+    RenderSettings s;
+    s.width = a.width;
+    s.height = a.height;
+    s.spp = a.spp;
+    Renderer r(ctx, scene, s);
+    r.renderPass();  // warm-up: lavapipe compiles each pipeline at its first dispatch
+    RenderStats before = r.stats();
+    auto t0 = std::chrono::steady_clock::now();
+    for (std::uint32_t i = 0; i < a.spp; ++i) r.renderPass();
+    double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    RenderStats after = r.stats();
+    double rays = double(after.rays - before.rays + after.shadowRays - before.shadowRays);
+    double samples = double(a.spp) * s.width * s.height;
+    char size[32];
+    std::snprintf(size, sizeof size, "%ux%u", s.width, s.height);
+    std::printf("%-40s %10zu %9s %8u %10.3f %12.0f %12.3f\n", path.empty() ? "default (cornell-box)" : path.c_str(),
+                r.summary().triangles, size, a.spp, sec, samples / sec, rays / sec / 1e6);
+  }
+  vk::destroyContext(ctx);
+  return kExitOk;
+}
+
+}  // namespace
+
+int runCli(int argc, char** argv) {
+  CLI::App app{"nusselt: a physically based renderer with generic BRDF sampling on Vulkan compute"};
+  app.set_version_flag("--version", NUSSELT_VERSION);
+  app.require_subcommand(1);
+
+  RenderArgs ra;
+  CLI::App* render = app.add_subcommand("render", "Render a glTF scene (default: the built-in Cornell box) to OpenEXR");
+  render->add_option("scene", ra.scene, "glTF 2.0 scene (.gltf or .glb); omitted: the built-in Cornell box");
+  render->add_option("-o,--output", ra.output, "Output OpenEXR file (32-bit float RGB)")->capture_default_str();
+  render->add_option("--spp", ra.spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(0u, 1u << 30));
+  render->add_option("--width", ra.width, "Image width in pixels (default 512, or from --height and the camera's aspect ratio)")
+      ->check(CLI::Range(1u, 65536u));
+  render->add_option("--height", ra.height, "Image height in pixels (default from the width and the camera's aspect ratio)")
+      ->check(CLI::Range(1u, 65536u));
+  render->add_option("--seed", ra.seed, "Random seed; same scene, settings and seed give a bit-identical image")
+      ->capture_default_str();
+  render->add_option("--max-depth", ra.maxDepth, "Maximum path depth (0: emitted light only, 1: direct lighting)")
+      ->capture_default_str()->check(CLI::Range(0u, 1024u));
+  render->add_option("--png", ra.png, "Also write a tone-mapped sRGB PNG");
+  render->add_option("--exposure", ra.exposure, "Exposure of the PNG, in stops")->capture_default_str();
+  render->add_option("--camera", ra.camera, "Use the glTF camera with this name (default: the first camera)");
+  render->add_option("--device", ra.device, "Vulkan device index (see `nusselt devices`; default: a discrete GPU if any)");
+  render->add_option("--lighting", ra.lighting, "Light transport estimator: mis (NEE + BSDF sampling, power heuristic), "
+                                                "nee (light sampling only), bsdf (BSDF sampling only)")
+      ->capture_default_str()->check(CLI::IsMember({"mis", "nee", "bsdf"}));
+  render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
+  render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
+  render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");
+
+  CLI::App* devices = app.add_subcommand("devices", "List the Vulkan devices and whether nusselt can use them");
+
+  BenchArgs ba;
+  CLI::App* bench = app.add_subcommand("bench", "Benchmarks that print figures");
+  bench->require_subcommand(1);
+  CLI::App* benchRender = bench->add_subcommand("render", "Samples/s and rays/s for the default scene and the dragon");
+  benchRender->add_option("scenes", ba.scenes, "Scenes to measure (default: the Cornell box and scenes/dragon)");
+  benchRender->add_option("--spp", ba.spp, "Timed samples per pixel (after one warm-up pass)")->capture_default_str()
+      ->check(CLI::Range(1u, 1u << 20));
+  benchRender->add_option("--width", ba.width, "Image width")->capture_default_str()->check(CLI::Range(1u, 65536u));
+  benchRender->add_option("--height", ba.height, "Image height")->capture_default_str()->check(CLI::Range(1u, 65536u));
+  benchRender->add_option("--device", ba.device, "Vulkan device index");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+  try {
+    if (*render) return renderCommand(ra);
+    if (*devices) return devicesCommand();
+    if (*benchRender) return benchRenderCommand(ba);
+  } catch (const Error& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kExitFailure;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "error: out of host memory\n");
+    return kExitFailure;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
+}  // namespace nusselt

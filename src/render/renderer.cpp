@@ -1,0 +1,450 @@
+// renderer.cpp: scene upload, pipelines and the wavefront pass.
+#include "render/renderer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "scene/bvh.h"
+#include "util/error.h"
+
+namespace nusselt {
+
+using shared::BvhNode;
+using shared::DispatchArgs;
+using shared::Globals;
+using shared::GpuLight;
+using shared::GpuMaterial;
+using shared::GpuTriangle;
+using shared::GpuTriShading;
+using shared::StageConstants;
+
+const char* lightingModeName(LightingMode mode) {
+  switch (mode) {
+    case LightingMode::Mis: return "mis";
+    case LightingMode::NeeOnly: return "nee";
+    case LightingMode::BsdfOnly: return "bsdf";
+  }
+  return "?";
+}
+
+namespace {
+
+double seconds(std::chrono::steady_clock::time_point a) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count();
+}
+
+glm::vec4 v4(glm::vec3 v, float w = 0.0f) { return glm::vec4(v, w); }
+
+float luminance(glm::vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+}  // namespace
+
+Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& settings)
+    : m_ctx(ctx), m_settings(settings) {
+  if (settings.width == 0 || settings.height == 0) throw Error("image size must be at least 1x1");
+  std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;
+  if (pixels > (1ull << 28)) throw Error("image too large: at most 2^28 pixels");
+  // One indirect dispatch covers a whole queue: its group count must stay <= 65535.
+  std::uint32_t maxChunk = std::min<std::uint32_t>(settings.maxPathsPerChunk, 65535u * WORKGROUP_SIZE);
+  m_capacity = static_cast<std::uint32_t>(std::min<std::uint64_t>(pixels, maxChunk));
+  uploadScene(scene);
+  auto t0 = std::chrono::steady_clock::now();
+  createPipelines();
+  m_summary.pipelineSeconds = seconds(t0);
+
+  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  ai.commandPool = m_ctx.commandPool;
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  VK_CHECK(vkAllocateCommandBuffers(m_ctx.device, &ai, &m_cmd));
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VK_CHECK(vkCreateFence(m_ctx.device, &fci, nullptr, &m_fence));
+}
+
+Renderer::~Renderer() {
+  VkDevice d = m_ctx.device;
+  vkDeviceWaitIdle(d);
+  if (m_fence) vkDestroyFence(d, m_fence, nullptr);
+  if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
+  for (auto* p : {&m_camera, &m_submit, &m_intersect, &m_shadow, &m_accumulate}) vk::destroyComputePipeline(m_ctx, *p);
+  for (auto& p : m_shade) vk::destroyComputePipeline(m_ctx, p);
+  if (m_descriptorPool) vkDestroyDescriptorPool(d, m_descriptorPool, nullptr);
+  if (m_pipelineLayout) vkDestroyPipelineLayout(d, m_pipelineLayout, nullptr);
+  if (m_setLayout) vkDestroyDescriptorSetLayout(d, m_setLayout, nullptr);
+  for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
+  vk::destroyBuffer(m_ctx, m_globalsBuffer);
+}
+
+void Renderer::uploadScene(const Scene& scene) {
+  const std::size_t triCount = scene.triangleCount();
+  m_summary.triangles = triCount;
+  m_summary.materials = scene.materials.size();
+
+  // ---- BVH (binned SAH) and triangles in BVH order ----
+  auto t0 = std::chrono::steady_clock::now();
+  Bvh bvh = buildBvh(scene.positions);
+  m_summary.bvhSeconds = seconds(t0);
+  m_summary.bvhNodes = static_cast<std::uint32_t>(bvh.nodes.size());
+
+  // ---- Materials and the model slots this render needs ----
+  std::vector<GpuMaterial> materials(std::max<std::size_t>(scene.materials.size(), 1));
+  std::vector<std::uint32_t> usedModels;
+  std::vector<bool> materialUsed(materials.size(), false);
+  for (std::uint32_t m : scene.triangleMaterial) materialUsed.at(m) = true;
+  for (std::size_t i = 0; i < scene.materials.size(); ++i)
+    if (materialUsed[i] && std::find(usedModels.begin(), usedModels.end(), scene.materials[i].model) == usedModels.end())
+      usedModels.push_back(scene.materials[i].model);
+  std::sort(usedModels.begin(), usedModels.end());
+  if (usedModels.size() > MAX_MODEL_SLOTS) throw Error("internal: too many models in one scene");
+  m_slotModels = usedModels;
+  for (std::uint32_t id : usedModels) m_summary.models.push_back(modelById(id).name);
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& src = scene.materials[i];
+    GpuMaterial& dst = materials[i];
+    std::uint32_t slot = 0;
+    for (std::uint32_t s = 0; s < usedModels.size(); ++s)
+      if (usedModels[s] == src.model) slot = s;
+    std::uint32_t flags = 0;
+    if (luminance(src.emission) > 0.0f || src.emission.x > 0 || src.emission.y > 0 || src.emission.z > 0)
+      flags |= MATERIAL_EMISSIVE;
+    if (modelById(src.model).delta) flags |= MATERIAL_DELTA;
+    dst.info = glm::uvec4(src.model, flags, 0u, slot);
+    dst.emission = v4(src.emission);
+    dst.params = src.params;
+  }
+
+  // ---- Triangles, shading data and lights ----
+  std::vector<GpuTriangle> tris(std::max<std::size_t>(triCount, 1));
+  std::vector<GpuTriShading> shading(std::max<std::size_t>(triCount, 1));
+  std::vector<GpuLight> lights;
+  std::vector<double> weights;
+  glm::vec3 lo(INFINITY), hi(-INFINITY);
+  for (std::size_t k = 0; k < triCount; ++k) {
+    std::uint32_t src = bvh.triangleOrder.empty() ? static_cast<std::uint32_t>(k) : bvh.triangleOrder[k];
+    glm::vec3 p0 = scene.positions[3 * src], p1 = scene.positions[3 * src + 1], p2 = scene.positions[3 * src + 2];
+    for (glm::vec3 p : {p0, p1, p2}) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+    tris[k].v0 = v4(p0);
+    tris[k].e1 = v4(p1 - p0);
+    tris[k].e2 = v4(p2 - p0);
+    shading[k].n0 = v4(scene.normals[3 * src]);
+    shading[k].n1 = v4(scene.normals[3 * src + 1]);
+    shading[k].n2 = v4(scene.normals[3 * src + 2]);
+    std::uint32_t mat = scene.triangleMaterial[src];
+    std::uint32_t lightIndex = INVALID_INDEX;
+    if (materials[mat].info.y & MATERIAL_EMISSIVE) {
+      float area = 0.5f * glm::length(glm::cross(p1 - p0, p2 - p0));
+      double power = double(luminance(scene.materials[mat].emission)) * area * M_PI;
+      if (power > 0) {
+        lightIndex = static_cast<std::uint32_t>(lights.size());
+        GpuLight l{};
+        l.info = glm::uvec4(LIGHT_TRIANGLE, static_cast<std::uint32_t>(k), 0u, 0u);
+        lights.push_back(l);
+        weights.push_back(power);
+      }
+    }
+    shading[k].info = glm::uvec4(mat, lightIndex, 0u, 0u);
+  }
+  glm::vec3 centre = triCount ? 0.5f * (lo + hi) : glm::vec3(0.0f);
+  float radius = triCount ? 0.5f * glm::length(hi - lo) : 1.0f;
+  for (const PunctualLight& pl : scene.lights) {
+    GpuLight l{};
+    double power = 0;
+    float lum = luminance(pl.intensity);
+    switch (pl.type) {
+      case LightType::Point:
+        l.info.x = LIGHT_POINT;
+        power = 4.0 * M_PI * lum;
+        break;
+      case LightType::Spot:
+        l.info.x = LIGHT_SPOT;
+        power = 2.0 * M_PI * (1.0 - std::cos(0.5 * (pl.innerConeAngle + pl.outerConeAngle))) * lum;
+        break;
+      case LightType::Directional:
+        l.info.x = LIGHT_DIRECTIONAL;
+        power = M_PI * double(radius) * radius * lum;
+        break;
+    }
+    if (!(power > 0)) continue;
+    l.position = v4(pl.position);
+    l.direction = v4(glm::normalize(pl.direction));
+    l.intensity = v4(pl.intensity);
+    l.cone = glm::vec4(std::cos(pl.innerConeAngle), std::cos(pl.outerConeAngle), 0.0f, 0.0f);
+    lights.push_back(l);
+    weights.push_back(power);
+  }
+  m_summary.lights = lights.size();
+  // Light selection proportional to estimated power.
+  std::vector<float> cdf(lights.size() + 1, 0.0f);
+  double total = 0;
+  for (double w : weights) total += w;
+  double acc = 0;
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    acc += weights[i];
+    cdf[i + 1] = static_cast<float>(acc / total);
+  }
+  if (!weights.empty()) cdf.back() = 1.0f;
+  if (lights.empty()) lights.resize(1);
+
+  // ---- Device buffers ----
+  std::uint64_t pixels = std::uint64_t(m_settings.width) * m_settings.height;
+  auto make = [&](VkDeviceSize bytes, const std::string& what, const void* data = nullptr,
+                  VkBufferUsageFlags usage = 0, bool host = false) -> vk::Buffer* {
+    m_buffers.push_back(vk::createBuffer(m_ctx, bytes, usage, host, what));
+    m_summary.deviceBytes += m_buffers.back().size;
+    if (data) vk::uploadBuffer(m_ctx, m_buffers.back(), data, bytes);
+    return &m_buffers.back();
+  };
+  m_buffers.reserve(32);  // pointers into m_buffers stay valid
+  std::vector<BvhNode> nodes = bvh.nodes;
+  if (nodes.empty()) {  // no triangles: a root whose two children are empty boxes
+    BvhNode n{};
+    n.min0 = n.min1 = glm::vec4(INFINITY);
+    n.max0 = n.max1 = glm::vec4(-INFINITY);
+    n.link = glm::uvec4(INVALID_INDEX, INVALID_INDEX, 0u, 0u);
+    nodes.push_back(n);
+  }
+  const std::uint64_t cap = m_capacity;
+  Globals g{};
+  g.bvh = make(nodes.size() * sizeof(BvhNode), "BVH", nodes.data())->address;
+  g.triangles = make(tris.size() * sizeof(GpuTriangle), "triangle", tris.data())->address;
+  g.shading = make(shading.size() * sizeof(GpuTriShading), "triangle shading", shading.data())->address;
+  g.materials = make(materials.size() * sizeof(GpuMaterial), "material", materials.data())->address;
+  g.lights = make(lights.size() * sizeof(GpuLight), "light", lights.data())->address;
+  g.lightCdf = make(cdf.size() * sizeof(float), "light CDF", cdf.data())->address;
+  m_film = make(pixels * 16, "film");
+  m_filmSq = make(pixels * 16, "film variance");
+  g.film = m_film->address;
+  g.filmSq = m_filmSq->address;
+  g.pathOrigin = make(cap * 16, "path origin")->address;
+  g.pathDirection = make(cap * 16, "path direction")->address;
+  g.pathThroughput = make(cap * 16, "path throughput")->address;
+  g.pathRadiance = make(cap * 16, "path radiance")->address;
+  g.pathInfo = make(cap * 16, "path info")->address;
+  g.pathHit = make(cap * 16, "path hit")->address;
+  g.shadowOrigin = make(cap * 16, "shadow ray origin")->address;
+  g.shadowDirection = make(cap * 16, "shadow ray direction")->address;
+  g.shadowRadiance = make(cap * 16, "shadow ray radiance")->address;
+  std::uint64_t queueUints = QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + usedModels.size()) * cap;
+  m_queues = make(queueUints * 4, "queue");
+  g.queues = m_queues->address;
+  m_args = make(QUEUE_COUNT * sizeof(DispatchArgs), "dispatch arguments", nullptr, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+  g.dispatchArgs = m_args->address;
+  m_stats = make(STAT_COUNT * 4, "statistics", nullptr, 0, true);
+  std::memset(m_stats->mapped, 0, STAT_COUNT * 4);
+  g.stats = m_stats->address;
+  float zero = 0.0f;
+  g.tables = make(4, "tables", &zero)->address;
+  g.pad0 = 0;
+
+  // Film starts at zero.
+  VkCommandBuffer cmd = vk::beginOneShot(m_ctx);
+  vkCmdFillBuffer(cmd, m_film->buffer, 0, VK_WHOLE_SIZE, 0);
+  vkCmdFillBuffer(cmd, m_filmSq->buffer, 0, VK_WHOLE_SIZE, 0);
+  vk::endOneShot(m_ctx, cmd);
+
+  // ---- Camera ----
+  Camera cam = scene.hasCamera ? scene.camera : frameScene(scene);
+  glm::vec3 f = glm::normalize(cam.forward);
+  glm::vec3 right = glm::normalize(glm::cross(f, cam.up));
+  glm::vec3 up = glm::cross(right, f);
+  float aspect = float(m_settings.width) / float(m_settings.height);
+  g.camPosition = v4(cam.position, cam.orthographic ? 1.0f : 0.0f);
+  g.camForward = v4(f);
+  if (cam.orthographic) {
+    g.camRight = v4(right * cam.xmag);
+    g.camUp = v4(up * cam.ymag);
+  } else {
+    float th = std::tan(0.5f * cam.yfov);
+    g.camRight = v4(right * (th * aspect));
+    g.camUp = v4(up * th);
+  }
+  g.sceneSphere = glm::vec4(centre, radius);
+  g.lightTotal = glm::vec4(float(total), 0, 0, 0);
+  g.background = v4(scene.background);
+  g.image = glm::uvec4(m_settings.width, m_settings.height, 0u, 0u);
+  g.frame = glm::uvec4(0u, m_settings.seed, m_settings.maxDepth, m_capacity);
+  g.counts = glm::uvec4(static_cast<std::uint32_t>(materials.size()), static_cast<std::uint32_t>(weights.size()),
+                        static_cast<std::uint32_t>(triCount), static_cast<std::uint32_t>(m_settings.lighting));
+  m_globals.resize(sizeof(Globals));
+  std::memcpy(m_globals.data(), &g, sizeof g);
+  m_globalsBuffer = vk::createBuffer(m_ctx, sizeof(Globals), 0, true, "globals");
+}
+
+void Renderer::createPipelines() {
+  VkDevice d = m_ctx.device;
+  VkDescriptorSetLayoutBinding binding{};
+  binding.binding = 0;
+  binding.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  binding.descriptorCount = 1;
+  binding.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  sl.bindingCount = 1;
+  sl.pBindings = &binding;
+  VK_CHECK(vkCreateDescriptorSetLayout(d, &sl, nullptr, &m_setLayout));
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(StageConstants)};
+  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &m_setLayout;
+  pl.pushConstantRangeCount = 1;
+  pl.pPushConstantRanges = &range;
+  VK_CHECK(vkCreatePipelineLayout(d, &pl, nullptr, &m_pipelineLayout));
+
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1};
+  VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  dp.maxSets = 1;
+  dp.poolSizeCount = 1;
+  dp.pPoolSizes = &size;
+  VK_CHECK(vkCreateDescriptorPool(d, &dp, nullptr, &m_descriptorPool));
+  VkDescriptorSetAllocateInfo da{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  da.descriptorPool = m_descriptorPool;
+  da.descriptorSetCount = 1;
+  da.pSetLayouts = &m_setLayout;
+  VK_CHECK(vkAllocateDescriptorSets(d, &da, &m_set));
+  VkDescriptorBufferInfo bi{m_globalsBuffer.buffer, 0, VK_WHOLE_SIZE};
+  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstSet = m_set;
+  w.dstBinding = 0;
+  w.descriptorCount = 1;
+  w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  w.pBufferInfo = &bi;
+  vkUpdateDescriptorSets(d, 1, &w, 0, nullptr);
+
+  m_camera = vk::createComputePipeline(m_ctx, m_pipelineLayout, "camera");
+  m_submit = vk::createComputePipeline(m_ctx, m_pipelineLayout, "submit");
+  m_intersect = vk::createComputePipeline(m_ctx, m_pipelineLayout, "intersect");
+  m_shadow = vk::createComputePipeline(m_ctx, m_pipelineLayout, "shadow");
+  m_accumulate = vk::createComputePipeline(m_ctx, m_pipelineLayout, "accumulate");
+  // Only the models this scene uses: one specialised shade pipeline each.
+  for (std::uint32_t model : m_slotModels) m_shade.push_back(vk::createComputePipeline(m_ctx, m_pipelineLayout, "shade", {model}));
+}
+
+void Renderer::dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst,
+                              std::uint32_t zeroCount, std::uint32_t argsFirst, std::uint32_t argsCount) {
+  StageConstants pc{};
+  pc.queueA = queueA;
+  pc.queueB = zeroFirst;
+  pc.queueBCount = zeroCount;
+  pc.queueC = argsFirst;
+  pc.queueCCount = argsCount;
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_submit.pipeline);
+  vkCmdPushConstants(cmd, m_pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
+  vkCmdDispatch(cmd, 1, 1, 1);
+  vk::computeBarrier(cmd);
+}
+
+void Renderer::recordPass(VkCommandBuffer cmd, std::uint32_t chunkStart, std::uint32_t chunkCount) {
+  (void)chunkStart;
+  const std::uint32_t slots = static_cast<std::uint32_t>(m_slotModels.size());
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_pipelineLayout, 0, 1, &m_set, 0, nullptr);
+  // All queues start empty.
+  vkCmdFillBuffer(cmd, m_queues->buffer, 0, QUEUE_HEADER_UINTS * 4, 0);
+  vk::computeBarrier(cmd);
+
+  StageConstants pc{};
+  auto bindAndPush = [&](const vk::ComputePipeline& p) {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+    vkCmdPushConstants(cmd, m_pipelineLayout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
+  };
+  const std::uint32_t groups = (chunkCount + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE;
+  bindAndPush(m_camera);
+  vkCmdDispatch(cmd, groups, 1, 1);
+  vk::computeBarrier(cmd);
+
+  for (std::uint32_t bounce = 0; bounce <= m_settings.maxDepth; ++bounce) {
+    const std::uint32_t rayQueue = bounce & 1u;
+    pc.bounce = bounce;
+    // intersect <- ray queue; empties the shadow queue of the previous bounce.
+    dispatchSubmit(cmd, rayQueue, QUEUE_SHADOW, 1, 0, 0);
+    bindAndPush(m_intersect);
+    vkCmdDispatchIndirect(cmd, m_args->buffer, rayQueue * sizeof(DispatchArgs));
+    vk::computeBarrier(cmd);
+    // shade(model) <- shade queues; empties the consumed ray queue.
+    dispatchSubmit(cmd, INVALID_INDEX, rayQueue, 1, QUEUE_SHADE_BASE, slots);
+    for (std::uint32_t s = 0; s < slots; ++s) {
+      pc.modelSlot = s;
+      bindAndPush(m_shade[s]);
+      vkCmdDispatchIndirect(cmd, m_args->buffer, (QUEUE_SHADE_BASE + s) * sizeof(DispatchArgs));
+    }
+    vk::computeBarrier(cmd);
+    // shadow <- shadow queue; empties the shade queues.
+    dispatchSubmit(cmd, QUEUE_SHADOW, QUEUE_SHADE_BASE, slots, 0, 0);
+    bindAndPush(m_shadow);
+    vkCmdDispatchIndirect(cmd, m_args->buffer, QUEUE_SHADOW * sizeof(DispatchArgs));
+    vk::computeBarrier(cmd);
+  }
+  bindAndPush(m_accumulate);
+  vkCmdDispatch(cmd, groups, 1, 1);
+  vk::computeBarrier(cmd);
+}
+
+void Renderer::renderPass() {
+  const std::uint64_t pixels = std::uint64_t(m_settings.width) * m_settings.height;
+  for (std::uint64_t start = 0; start < pixels; start += m_capacity) {
+    std::uint32_t count = static_cast<std::uint32_t>(std::min<std::uint64_t>(m_capacity, pixels - start));
+    Globals* g = reinterpret_cast<Globals*>(m_globals.data());
+    g->image.z = static_cast<std::uint32_t>(start);
+    g->image.w = count;
+    g->frame.x = m_samples;
+    std::memcpy(m_globalsBuffer.mapped, m_globals.data(), sizeof(Globals));
+
+    VK_CHECK(vkResetCommandBuffer(m_cmd, 0));
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    VK_CHECK(vkBeginCommandBuffer(m_cmd, &bi));
+    recordPass(m_cmd, g->image.z, count);
+    VK_CHECK(vkEndCommandBuffer(m_cmd));
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &m_cmd;
+    VK_CHECK(vkResetFences(m_ctx.device, 1, &m_fence));
+    VK_CHECK(vkQueueSubmit(m_ctx.queue, 1, &si, m_fence));
+    VK_CHECK(vkWaitForFences(m_ctx.device, 1, &m_fence, VK_TRUE, UINT64_MAX));
+    // Fold the 32-bit device counters into 64-bit totals and restart them.
+    std::uint32_t* s = static_cast<std::uint32_t*>(m_stats->mapped);
+    m_totals.rays += s[STAT_RAYS];
+    m_totals.shadowRays += s[STAT_SHADOW_RAYS];
+    m_totals.nonFiniteSamples += s[STAT_NONFINITE_SAMPLES];
+    m_totals.bvhStackOverflows += s[STAT_BVH_STACK_OVERFLOW];
+    m_totals.samplerBoundViolations += s[STAT_SAMPLER_BOUND_VIOLATIONS];
+    m_totals.samplerTrialFailures += s[STAT_SAMPLER_TRIAL_FAILURES];
+    std::memset(s, 0, STAT_COUNT * 4);
+  }
+  ++m_samples;
+}
+
+Image Renderer::image(bool withVariance) {
+  const std::uint64_t pixels = std::uint64_t(m_settings.width) * m_settings.height;
+  std::vector<glm::vec4> sum(pixels), sumSq;
+  vk::downloadBuffer(m_ctx, *m_film, sum.data(), pixels * 16);
+  if (withVariance) {
+    sumSq.resize(pixels);
+    vk::downloadBuffer(m_ctx, *m_filmSq, sumSq.data(), pixels * 16);
+  }
+  Image img;
+  img.width = static_cast<int>(m_settings.width);
+  img.height = static_cast<int>(m_settings.height);
+  img.rgb.resize(pixels * 3);
+  if (withVariance) img.variance.resize(pixels * 3);
+  for (std::uint64_t i = 0; i < pixels; ++i) {
+    float n = sum[i].w;
+    for (int c = 0; c < 3; ++c) {
+      float mean = n > 0 ? sum[i][c] / n : 0.0f;
+      img.rgb[3 * i + c] = mean;
+      if (withVariance) {
+        // Unbiased sample variance of one sample, divided by n: the variance of the mean.
+        double var = n > 1 ? (double(sumSq[i][c]) - double(n) * mean * mean) / (double(n) - 1.0) : 0.0;
+        img.variance[3 * i + c] = n > 0 ? static_cast<float>(std::max(var, 0.0) / n) : 0.0f;
+      }
+    }
+  }
+  return img;
+}
+
+RenderStats Renderer::stats() const { return m_totals; }
+
+}  // namespace nusselt

@@ -1,0 +1,101 @@
+// renderer.h: the wavefront path tracer. Owns the device buffers of one scene and runs sample
+// passes: each pass traces one sample per pixel through the stages
+//   camera -> [intersect -> shade(model) -> shadow] x (max depth + 1) -> accumulate
+// with queues between the stages and indirect dispatches sized by the queues.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "io/image.h"
+#include "scene/scene.h"
+#include "vk/vk.h"
+
+namespace nusselt {
+
+enum class LightingMode : std::uint32_t { Mis = 0, NeeOnly = 1, BsdfOnly = 2 };
+const char* lightingModeName(LightingMode mode);
+
+struct RenderSettings {
+  std::uint32_t width = 512;
+  std::uint32_t height = 512;
+  std::uint32_t spp = 64;
+  std::uint32_t maxDepth = 8;       // pbrt's convention: 0 = emitted light only, 1 = direct light
+  std::uint32_t seed = 0;
+  LightingMode lighting = LightingMode::Mis;
+  // Paths traced together in one chunk of a pass (path state memory ~128 bytes each).
+  std::uint32_t maxPathsPerChunk = 1u << 20;
+};
+
+struct RenderStats {
+  std::uint64_t rays = 0;
+  std::uint64_t shadowRays = 0;
+  std::uint64_t nonFiniteSamples = 0;
+  std::uint64_t bvhStackOverflows = 0;
+  std::uint64_t samplerBoundViolations = 0;
+  std::uint64_t samplerTrialFailures = 0;
+};
+
+struct SceneSummary {
+  std::size_t triangles = 0;
+  std::size_t materials = 0;
+  std::size_t lights = 0;
+  std::vector<std::string> models;  // models the render's shade stages contain
+  double bvhSeconds = 0;
+  std::uint32_t bvhNodes = 0;
+  double pipelineSeconds = 0;       // creating the pipelines (lavapipe compiles at first dispatch)
+  std::uint64_t deviceBytes = 0;
+};
+
+class Renderer {
+ public:
+  Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& settings);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Traces one more sample per pixel (sample index = samplesDone()).
+  void renderPass();
+  std::uint32_t samplesDone() const { return m_samples; }
+  // The current estimate: film sum / samples; variance of the mean when withVariance.
+  Image image(bool withVariance = false);
+  RenderStats stats() const;
+  const SceneSummary& summary() const { return m_summary; }
+  const RenderSettings& settings() const { return m_settings; }
+
+ private:
+  void uploadScene(const Scene& scene);
+  void createPipelines();
+  void recordPass(VkCommandBuffer cmd, std::uint32_t chunkStart, std::uint32_t chunkCount);
+  void dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst, std::uint32_t zeroCount,
+                      std::uint32_t argsFirst, std::uint32_t argsCount);
+
+  vk::Context& m_ctx;
+  RenderSettings m_settings;
+  SceneSummary m_summary;
+  std::uint32_t m_samples = 0;
+  std::uint32_t m_capacity = 0;
+  RenderStats m_totals;
+  std::vector<std::uint32_t> m_slotModels;  // model id of each shade slot
+
+  // Host copy of the globals, rewritten before each chunk.
+  std::vector<unsigned char> m_globals;
+  vk::Buffer m_globalsBuffer;
+  std::vector<vk::Buffer> m_buffers;  // everything else, destroyed together
+  vk::Buffer* m_film = nullptr;
+  vk::Buffer* m_filmSq = nullptr;
+  vk::Buffer* m_queues = nullptr;
+  vk::Buffer* m_args = nullptr;
+  vk::Buffer* m_stats = nullptr;
+
+  VkDescriptorSetLayout m_setLayout = VK_NULL_HANDLE;
+  VkPipelineLayout m_pipelineLayout = VK_NULL_HANDLE;
+  VkDescriptorPool m_descriptorPool = VK_NULL_HANDLE;
+  VkDescriptorSet m_set = VK_NULL_HANDLE;
+  vk::ComputePipeline m_camera, m_submit, m_intersect, m_shadow, m_accumulate;
+  std::vector<vk::ComputePipeline> m_shade;  // one per slot
+  VkCommandBuffer m_cmd = VK_NULL_HANDLE;
+  VkFence m_fence = VK_NULL_HANDLE;
+};
+
+}  // namespace nusselt

@@ -1,0 +1,492 @@
+// bvh.cpp: binned-SAH BVH builder (see bvh.h for the node encoding) and the C++ reference
+// traversal that mirrors shaders/shared/bvh_traverse.glsl.
+#include "scene/bvh.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <thread>
+
+namespace nusselt {
+namespace {
+
+using shared::BvhNode;
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+// SAH bins per axis: 32 is within a percent or two of a full sweep on typical meshes.
+constexpr int kBins = 32;
+// Cost of visiting one node relative to testing one triangle. A node visit tests two boxes and
+// fetches 80 bytes, a triangle test fetches 48 bytes and does a few cross products: roughly even.
+constexpr float kTraversalCost = 1.0f;
+// Subtrees at least this large are built on their own thread (below that a thread costs more
+// than it saves).
+constexpr std::uint32_t kParallelMinTriangles = 32 * 1024;
+
+struct Aabb {
+  glm::vec3 lo{kInf};
+  glm::vec3 hi{-kInf};
+
+  void grow(glm::vec3 p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  void grow(const Aabb& b) {
+    lo = glm::min(lo, b.lo);
+    hi = glm::max(hi, b.hi);
+  }
+  // Half the surface area (the factor 2 cancels in every SAH ratio). 0 for an empty box, so
+  // that empty bins never produce a NaN; double, because scenes spanning 1e20 overflow a float.
+  double halfArea() const {
+    if (!(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z)) return 0.0;
+    const glm::dvec3 d = glm::dvec3(hi) - glm::dvec3(lo);
+    return d.x * d.y + d.y * d.z + d.z * d.x;
+  }
+};
+
+// One triangle as the builder sees it: its box and its original index. Prims are partitioned in
+// place, so every pass over a node's range reads memory sequentially (indirection through an
+// index array made the 2M-triangle build cache-bound). 32 bytes.
+struct Prim {
+  glm::vec3 lo;
+  std::uint32_t id;
+  glm::vec3 hi;
+  std::uint32_t pad;
+  // Twice the box centre: the factor 2 is irrelevant to binning and saves a multiply.
+  glm::vec3 centre2() const { return lo + hi; }
+};
+
+// A child reference as its parent stores it.
+struct ChildRef {
+  std::uint32_t index = INVALID_INDEX;
+  std::uint32_t count = 0;  // > 0: leaf
+  Aabb box;
+};
+
+struct LocalStats {
+  std::uint32_t leaves = 0;
+  std::uint32_t maxDepth = 0;
+  std::uint32_t maxLeafSize = 0;
+
+  void merge(const LocalStats& o) {
+    leaves += o.leaves;
+    maxDepth = std::max(maxDepth, o.maxDepth);
+    maxLeafSize = std::max(maxLeafSize, o.maxLeafSize);
+  }
+};
+
+struct Split {
+  bool valid = false;
+  int axis = 0;
+  int bin = 0;  // prims with bin index < bin go left
+  std::uint32_t countLeft = 0, countRight = 0;
+  double cost = kInf;  // SAH cost of splitting, in units of one triangle test
+};
+
+// Inner-node levels a subtree of n triangles needs under pure median splitting: the number of
+// levels below a node of n triangles before every part fits in a leaf.
+std::uint32_t medianLevels(std::uint32_t n) {
+  std::uint32_t levels = 0;
+  std::uint64_t capacity = kBvhMaxLeafSize;
+  while (capacity < n) {
+    capacity *= 2;
+    ++levels;
+  }
+  return levels;
+}
+
+// The bin of a centre coordinate. One function for binning and partitioning so that both see
+// bit-identical results.
+inline int binOf(float c, float cmin, float scale) {
+  int b = static_cast<int>((c - cmin) * scale);
+  return std::min(std::max(b, 0), kBins - 1);
+}
+
+class Builder {
+ public:
+  Builder(Prim* prims, std::uint32_t parallelDepth) : prims_(prims), parallelDepth_(parallelDepth) {}
+
+  // Builds the subtree of prims [begin, end) whose root sits at `depth` (number of inner nodes
+  // above it). Inner nodes are appended to `out` with indices relative to `out`; leaf indices are
+  // absolute positions in the prim array. Returns how the parent refers to it.
+  ChildRef build(std::uint32_t begin, std::uint32_t end, std::uint32_t depth,
+                 std::vector<BvhNode>& out, LocalStats& stats) const {
+    const std::uint32_t n = end - begin;
+    ChildRef ref;
+    Aabb centres;
+    for (std::uint32_t i = begin; i < end; ++i) {
+      ref.box.grow(prims_[i].lo);
+      ref.box.grow(prims_[i].hi);
+      centres.grow(prims_[i].centre2());
+    }
+
+    Split split;
+    if (n >= 2) split = findSahSplit(begin, end, ref.box, centres);
+    // SAH may peel off one triangle per level (e.g. exponentially spaced input): accept its split
+    // only while both children can still reach leaf size by median splits within the depth cap.
+    const bool sahFits = split.valid && depth + 1 + medianLevels(split.countLeft) <= kBvhMaxDepth &&
+                         depth + 1 + medianLevels(split.countRight) <= kBvhMaxDepth;
+
+    if (n <= kBvhMaxLeafSize && (n == 1 || !sahFits || static_cast<double>(n) <= split.cost)) {
+      ref.index = begin;
+      ref.count = n;
+      stats.leaves++;
+      stats.maxDepth = std::max(stats.maxDepth, depth);
+      stats.maxLeafSize = std::max(stats.maxLeafSize, n);
+      return ref;
+    }
+
+    std::uint32_t mid = begin;
+    if (sahFits) {
+      const float cmin = centres.lo[split.axis];
+      const float scale = binScale(centres, split.axis);
+      const int axis = split.axis, bin = split.bin;
+      Prim* m = std::partition(prims_ + begin, prims_ + end, [&](const Prim& p) {
+        return binOf(p.centre2()[axis], cmin, scale) < bin;
+      });
+      mid = static_cast<std::uint32_t>(m - prims_);
+    }
+    if (mid == begin || mid == end) {
+      // No usable SAH split (coincident centres, or the depth cap is near): split at the median
+      // along the longest centre axis. With coincident centres this is a split by index; either
+      // way both halves shrink by half, which is what keeps the depth bounded.
+      glm::vec3 ext = centres.hi - centres.lo;
+      const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+      mid = begin + n / 2;
+      std::nth_element(prims_ + begin, prims_ + mid, prims_ + end, [axis](const Prim& a, const Prim& b) {
+        return a.centre2()[axis] < b.centre2()[axis];
+      });
+    }
+
+    const std::uint32_t nodeIndex = static_cast<std::uint32_t>(out.size());
+    out.emplace_back();
+    ref.index = nodeIndex;
+    ref.count = 0;
+
+    ChildRef left, right;
+    if (depth < parallelDepth_ && n >= kParallelMinTriangles) {
+      // Right subtree on another thread into its own node array, appended after the left subtree:
+      // the same depth-first layout as a serial build, so the result is thread-count independent.
+      std::vector<BvhNode> rightNodes;
+      LocalStats rightStats;
+      std::exception_ptr error;
+      std::thread worker([&] {
+        try {
+          right = build(mid, end, depth + 1, rightNodes, rightStats);
+        } catch (...) {
+          error = std::current_exception();
+        }
+      });
+      try {
+        left = build(begin, mid, depth + 1, out, stats);
+      } catch (...) {
+        worker.join();
+        throw;
+      }
+      worker.join();
+      if (error) std::rethrow_exception(error);
+      const std::uint32_t offset = static_cast<std::uint32_t>(out.size());
+      for (BvhNode& node : rightNodes) {
+        if (node.link.z == 0 && node.link.x != INVALID_INDEX) node.link.x += offset;
+        if (node.link.w == 0 && node.link.y != INVALID_INDEX) node.link.y += offset;
+      }
+      if (right.count == 0) right.index += offset;
+      out.insert(out.end(), rightNodes.begin(), rightNodes.end());
+      stats.merge(rightStats);
+    } else {
+      left = build(begin, mid, depth + 1, out, stats);
+      right = build(mid, end, depth + 1, out, stats);
+    }
+    // `out` may have grown: index, don't hold a reference across the recursion.
+    out[nodeIndex] = makeNode(left, right);
+    return ref;
+  }
+
+  static BvhNode makeNode(const ChildRef& a, const ChildRef& b) {
+    BvhNode node;
+    node.min0 = glm::vec4(a.box.lo, 0.0f);
+    node.max0 = glm::vec4(a.box.hi, 0.0f);
+    node.min1 = glm::vec4(b.box.lo, 0.0f);
+    node.max1 = glm::vec4(b.box.hi, 0.0f);
+    node.link = glm::uvec4(a.index, b.index, a.count, b.count);
+    return node;
+  }
+
+ private:
+  static float binScale(const Aabb& centres, int axis) {
+    const float extent = centres.hi[axis] - centres.lo[axis];
+    return extent > 0.0f ? static_cast<float>(kBins) / extent : 0.0f;
+  }
+
+  Split findSahSplit(std::uint32_t begin, std::uint32_t end, const Aabb& box, const Aabb& centres) const {
+    struct Bin {
+      Aabb box;
+      std::uint32_t count = 0;
+    };
+    std::array<std::array<Bin, kBins>, 3> bins{};
+    std::array<float, 3> scale{}, cmin{};
+    for (int a = 0; a < 3; ++a) {
+      scale[a] = binScale(centres, a);
+      cmin[a] = centres.lo[a];
+    }
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const Prim& p = prims_[i];
+      const glm::vec3 c = p.centre2();
+      for (int a = 0; a < 3; ++a) {
+        Bin& bin = bins[a][binOf(c[a], cmin[a], scale[a])];
+        bin.box.lo = glm::min(bin.box.lo, p.lo);
+        bin.box.hi = glm::max(bin.box.hi, p.hi);
+        bin.count++;
+      }
+    }
+
+    Split best;
+    double bestWeighted = kInf;  // sum of area * count over both sides
+    for (int a = 0; a < 3; ++a) {
+      if (scale[a] == 0.0f) continue;  // flat along this axis: every prim is in bin 0
+      // Sweep from the right: rightArea[b], rightCount[b] describe bins [b, kBins).
+      std::array<double, kBins> rightArea{};
+      std::array<std::uint32_t, kBins> rightCount{};
+      Aabb acc;
+      std::uint32_t count = 0;
+      for (int b = kBins - 1; b > 0; --b) {
+        acc.grow(bins[a][b].box);
+        count += bins[a][b].count;
+        rightArea[b] = acc.halfArea();
+        rightCount[b] = count;
+      }
+      acc = Aabb();
+      count = 0;
+      for (int b = 1; b < kBins; ++b) {
+        acc.grow(bins[a][b - 1].box);
+        count += bins[a][b - 1].count;
+        if (count == 0 || rightCount[b] == 0) continue;
+        const double weighted = acc.halfArea() * count + rightArea[b] * rightCount[b];
+        if (weighted < bestWeighted) {
+          bestWeighted = weighted;
+          best.valid = true;
+          best.axis = a;
+          best.bin = b;
+          best.countLeft = count;
+          best.countRight = rightCount[b];
+        }
+      }
+    }
+    if (best.valid) {
+      const double area = std::max(box.halfArea(), std::numeric_limits<double>::min());
+      best.cost = kTraversalCost + bestWeighted / area;
+    }
+    return best;
+  }
+
+  Prim* prims_;
+  std::uint32_t parallelDepth_;
+};
+
+double computeSahCost(const std::vector<BvhNode>& nodes) {
+  auto halfArea = [](glm::vec4 lo, glm::vec4 hi) {
+    Aabb b;
+    b.lo = glm::vec3(lo);
+    b.hi = glm::vec3(hi);
+    return b.halfArea();
+  };
+  const BvhNode& root = nodes[0];
+  Aabb rootBox;
+  rootBox.lo = glm::min(glm::vec3(root.min0), glm::vec3(root.min1));
+  rootBox.hi = glm::max(glm::vec3(root.max0), glm::vec3(root.max1));
+  const double rootArea = std::max(rootBox.halfArea(), std::numeric_limits<double>::min());
+  double cost = 0.0;
+  std::vector<std::pair<std::uint32_t, double>> stack{{0u, rootArea}};
+  while (!stack.empty()) {
+    auto [index, area] = stack.back();
+    stack.pop_back();
+    cost += kTraversalCost * area / rootArea;
+    const BvhNode& node = nodes[index];
+    const std::uint32_t child[2] = {node.link.x, node.link.y};
+    const std::uint32_t count[2] = {node.link.z, node.link.w};
+    const double childArea[2] = {halfArea(node.min0, node.max0), halfArea(node.min1, node.max1)};
+    for (int c = 0; c < 2; ++c) {
+      if (count[c] > 0) {
+        cost += count[c] * childArea[c] / rootArea;
+      } else if (child[c] != INVALID_INDEX) {
+        stack.push_back({child[c], childArea[c]});
+      }
+    }
+  }
+  return cost;
+}
+
+}  // namespace
+
+Bvh buildBvh(const std::vector<glm::vec3>& positions) {
+  const auto start = std::chrono::steady_clock::now();
+  Bvh bvh;
+  const std::uint32_t count = static_cast<std::uint32_t>(positions.size() / 3);
+  if (count == 0) return bvh;
+
+  std::vector<Prim> prims(count);
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const glm::vec3 &a = positions[3 * i], &b = positions[3 * i + 1], &c = positions[3 * i + 2];
+    prims[i].lo = glm::min(a, glm::min(b, c));
+    prims[i].hi = glm::max(a, glm::max(b, c));
+    prims[i].id = i;
+    prims[i].pad = 0;
+  }
+
+  // Spawn threads on the top levels only: 2^parallelDepth subtrees, about twice the core count,
+  // so that uneven SAH splits still keep every core busy.
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  std::uint32_t parallelDepth = 0;
+  while ((1u << parallelDepth) < 2 * cores && parallelDepth < 8) ++parallelDepth;
+  if (cores == 1) parallelDepth = 0;
+
+  Builder builder(prims.data(), parallelDepth);
+  LocalStats stats;
+  bvh.nodes.reserve(count / 2 + 1);
+  ChildRef root = builder.build(0, count, 0, bvh.nodes, stats);
+  if (root.count > 0) {
+    // The whole scene fits in one leaf: the root (always an inner node) gets it as child0 and an
+    // empty slot as child1 (inverted box, INVALID_INDEX, count 0; see bvh.h).
+    bvh.nodes.push_back(Builder::makeNode(root, ChildRef()));
+    stats.maxDepth = 1;
+  }
+
+  bvh.triangleOrder.resize(count);
+  for (std::uint32_t i = 0; i < count; ++i) bvh.triangleOrder[i] = prims[i].id;
+
+  bvh.stats.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
+  bvh.stats.leaves = stats.leaves;
+  bvh.stats.maxDepth = stats.maxDepth;
+  bvh.stats.maxLeafSize = stats.maxLeafSize;
+  bvh.stats.sahCost = computeSahCost(bvh.nodes);
+  bvh.stats.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return bvh;
+}
+
+// ---- Reference traversal: keep in step with shaders/shared/bvh_traverse.glsl ---------------------
+
+namespace {
+
+// Widening of a box's exit distance: covers the rounding of the slab computation so that a
+// triangle lying in a box face (flat boxes) is never culled (1 + 2 gamma(3), PBRT 4 6.8.2).
+constexpr float kSlabExitScale = 1.0000004f;
+// Smallest direction component used for the inverse: keeps 1/d finite, so (plane - o) * inv
+// never evaluates 0 * inf = NaN. Replacing a zero component by +-1e-30 tilts the ray by a
+// negligible angle; its one visible effect is that a ray lying exactly in a box face plane is
+// inside the slab at one face (the min face for +0) and outside at the other. The only hits that
+// can be lost are thus on triangle edges lying exactly in such a plane (e.g. a straight-down ray
+// through the outer edge of an axis-aligned floor): grazing hits, which Moller-Trumbore's
+// edge test already decides arbitrarily.
+constexpr float kMinDirection = 1e-30f;
+
+struct RayBoxSetup {
+  glm::vec3 origin, inv;
+  glm::bvec3 positive;
+};
+
+RayBoxSetup setupRay(glm::vec3 origin, glm::vec3 dir) {
+  RayBoxSetup r;
+  r.origin = origin;
+  for (int a = 0; a < 3; ++a) {
+    const float d = std::abs(dir[a]) >= kMinDirection ? dir[a] : (dir[a] >= 0.0f ? kMinDirection : -kMinDirection);
+    r.inv[a] = 1.0f / d;
+    r.positive[a] = r.inv[a] >= 0.0f;
+  }
+  return r;
+}
+
+// Slab test choosing the entry plane by direction sign (not min/max of both planes): an inverted
+// (empty) box then gives entry +inf > exit -inf and is missed.
+bool hitBox(const RayBoxSetup& r, glm::vec4 bmin, glm::vec4 bmax, float tmin, float tmax, float& tEnter) {
+  glm::vec3 nearPlane, farPlane;
+  for (int a = 0; a < 3; ++a) {
+    nearPlane[a] = r.positive[a] ? bmin[a] : bmax[a];
+    farPlane[a] = r.positive[a] ? bmax[a] : bmin[a];
+  }
+  const glm::vec3 tn = (nearPlane - r.origin) * r.inv;
+  const glm::vec3 tf = (farPlane - r.origin) * r.inv;
+  tEnter = std::max(std::max(tn.x, tn.y), std::max(tn.z, tmin));
+  const float tExit = std::min(std::min(tf.x, tf.y), std::min(tf.z, tmax)) * kSlabExitScale;
+  return tEnter <= tExit;
+}
+
+}  // namespace
+
+bool intersectTriangle(glm::vec3 origin, glm::vec3 dir, glm::vec3 v0, glm::vec3 e1, glm::vec3 e2,
+                       float tmin, float tmax, float& t, float& b1, float& b2) {
+  const glm::vec3 p = glm::cross(dir, e2);
+  const float det = glm::dot(e1, p);
+  if (det == 0.0f) return false;
+  const float invDet = 1.0f / det;
+  const glm::vec3 s = origin - v0;
+  const float u = glm::dot(s, p) * invDet;
+  const glm::vec3 q = glm::cross(s, e1);
+  const float v = glm::dot(dir, q) * invDet;
+  const float tt = glm::dot(e2, q) * invDet;
+  // Written as conjunctions so that a NaN anywhere rejects the hit.
+  if (u >= 0.0f && v >= 0.0f && u + v <= 1.0f && tt > tmin && tt < tmax) {
+    t = tt;
+    b1 = u;
+    b2 = v;
+    return true;
+  }
+  return false;
+}
+
+bool bvhClosestHit(const Bvh& bvh, const std::vector<glm::vec3>& positions, glm::vec3 origin,
+                   glm::vec3 dir, float tmin, float tmax, float& t, std::uint32_t& tri) {
+  if (bvh.nodes.empty()) return false;
+  const RayBoxSetup ray = setupRay(origin, dir);
+  std::uint32_t stack[BVH_STACK_SIZE];
+  int sp = 0;
+  std::uint32_t node = 0;
+  float best = tmax;
+  bool found = false;
+  auto testLeaf = [&](std::uint32_t first, std::uint32_t count) {
+    for (std::uint32_t i = first; i < first + count; ++i) {
+      const std::uint32_t o = bvh.triangleOrder[i];
+      const glm::vec3 v0 = positions[3 * o];
+      float tt, b1, b2;
+      if (intersectTriangle(origin, dir, v0, positions[3 * o + 1] - v0, positions[3 * o + 2] - v0, tmin,
+                            best, tt, b1, b2)) {
+        best = tt;
+        tri = i;
+        found = true;
+      }
+    }
+  };
+  for (;;) {
+    const BvhNode& n = bvh.nodes[node];
+    float enter0, enter1;
+    bool hit0 = hitBox(ray, n.min0, n.max0, tmin, best, enter0);
+    bool hit1 = hitBox(ray, n.min1, n.max1, tmin, best, enter1);
+    if (hit0 && n.link.z > 0) {
+      testLeaf(n.link.x, n.link.z);
+      hit0 = false;
+    }
+    if (hit1 && n.link.w > 0) {
+      testLeaf(n.link.y, n.link.w);
+      hit1 = false;
+    }
+    if (hit0 && hit1) {
+      if (sp >= BVH_STACK_SIZE) break;  // the GPU counts STAT_BVH_STACK_OVERFLOW here
+      const bool firstNear = enter0 <= enter1;
+      stack[sp++] = firstNear ? n.link.y : n.link.x;
+      node = firstNear ? n.link.x : n.link.y;
+    } else if (hit0) {
+      node = n.link.x;
+    } else if (hit1) {
+      node = n.link.y;
+    } else {
+      if (sp == 0) break;
+      node = stack[--sp];
+    }
+  }
+  if (found) t = best;
+  return found;
+}
+
+}  // namespace nusselt

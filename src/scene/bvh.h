@@ -1,0 +1,70 @@
+// bvh.h: the CPU builder of the bounding volume hierarchy the GPU traverses
+// (shaders/shared/bvh_traverse.glsl).
+//
+// Node encoding (shared::BvhNode, shaders/shared/layout.h): a node stores the boxes of both of
+// its children; link = (child0, child1, count0, count1).
+//   - count > 0: the child is a leaf holding triangles [child, child + count) of the reordered
+//     triangle array (position i holds original triangle triangleOrder[i]); count <= kBvhMaxLeafSize.
+//   - count == 0 and child != INVALID_INDEX: the child is the inner node nodes[child].
+//   - count == 0 and child == INVALID_INDEX: an empty slot. Its box is inverted (min = +inf,
+//     max = -inf); the traversal's slab test picks the entry/exit plane by the sign of the ray
+//     direction, so an inverted box always yields entry = +inf > exit = -inf and is never entered.
+//     Only the root of a one-leaf tree has an empty slot (child1).
+// nodes[0] is the root and is always an inner node (when there is at least one triangle).
+// Nodes are laid out depth first: an inner child0 is usually the next node (cache locality).
+//
+// Depth: a leaf's depth is the number of inner nodes above it (children of the root have depth
+// 1). The builder guarantees stats.maxDepth <= kBvhMaxDepth = BVH_STACK_SIZE - 2, which bounds
+// the GPU traversal stack (it holds at most one deferred node per level).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "../../shaders/shared/layout.h"
+
+namespace nusselt {
+
+// Leaves never hold more triangles than this: the GPU leaf loop is bounded by it.
+constexpr std::uint32_t kBvhMaxLeafSize = 8;
+// The deepest leaf allowed (see above).
+constexpr std::uint32_t kBvhMaxDepth = BVH_STACK_SIZE - 2;
+
+struct BvhBuildStats {
+  std::uint32_t nodes = 0;        // inner nodes (== Bvh::nodes.size())
+  std::uint32_t leaves = 0;       // non-empty leaves
+  std::uint32_t maxDepth = 0;     // deepest leaf, <= kBvhMaxDepth
+  std::uint32_t maxLeafSize = 0;  // <= kBvhMaxLeafSize
+  double seconds = 0.0;           // wall-clock build time
+  // SAH cost of the tree: sum over inner nodes of area/rootArea (traversal cost 1) plus sum over
+  // leaves of count * area/rootArea (intersection cost 1). Useful to compare builder changes.
+  double sahCost = 0.0;
+};
+
+struct Bvh {
+  std::vector<shared::BvhNode> nodes;   // nodes[0] is the root; empty for an empty scene
+  std::vector<std::uint32_t> triangleOrder;  // new position i holds original triangle triangleOrder[i]
+  BvhBuildStats stats;
+};
+
+// positions: 3 per triangle (world space), all finite. Binned SAH (32 bins on each axis) with
+// SAH leaf termination, falling back to a median split where SAH would exceed the depth cap and
+// to an index split where all centroids coincide. Large inputs build their top subtrees on
+// several threads. The result does not depend on the number of threads.
+Bvh buildBvh(const std::vector<glm::vec3>& positions);
+
+// ---- Reference traversal (tests only) -----------------------------------------------------------
+// The C++ twin of traceClosest in bvh_traverse.glsl: same slab test, same Moller-Trumbore, same
+// stack discipline. positions are the ORIGINAL (not reordered) positions given to buildBvh; tri
+// is returned as an index into the reordered array (as on the GPU): the original triangle is
+// bvh.triangleOrder[tri]. Returns the nearest hit with tmin < t < tmax.
+bool bvhClosestHit(const Bvh& bvh, const std::vector<glm::vec3>& positions, glm::vec3 origin,
+                   glm::vec3 dir, float tmin, float tmax, float& t, std::uint32_t& tri);
+
+// Moller-Trumbore against one triangle (v0, e1 = v1 - v0, e2 = v2 - v0), both faces, exactly as
+// the GPU computes it. Exposed so that tests can brute-force with the same arithmetic.
+bool intersectTriangle(glm::vec3 origin, glm::vec3 dir, glm::vec3 v0, glm::vec3 e1, glm::vec3 e2,
+                       float tmin, float tmax, float& t, float& b1, float& b2);
+
+}  // namespace nusselt

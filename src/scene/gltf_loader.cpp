@@ -1,0 +1,1102 @@
+// gltf_loader.cpp: glTF 2.0 -> Scene.
+//
+// The file is untrusted input. tinygltf 2.7.0 does the JSON-to-struct work, but it follows `../`
+// and absolute URIs, misreads a directory named by a URI as a huge file, and leaves accessor
+// bounds to the caller. So before tinygltf sees anything we:
+//   - read the file ourselves (regular file, size cap) and split GLB chunks with checked sizes,
+//   - parse the JSON once with nlohmann (after a cheap nesting-depth scan, because tinygltf
+//     converts extension values recursively) and vet every buffer URI against the scene folder,
+//   - drop `images` (not supported yet) so no image bytes are ever decoded or sliced,
+// and hand tinygltf file-system callbacks that only open regular files inside the scene folder.
+// After tinygltf, every index and every accessor is checked before a single byte is read.
+#include "scene/gltf_loader.h"
+
+#include <fstream>  // tinygltf's writer needs it even with TINYGLTF_NO_FS
+
+#include <nlohmann/json.hpp>
+
+#define TINYGLTF_IMPLEMENTATION
+#define TINYGLTF_NO_FS  // our own callbacks only: tinygltf's defaults would escape the folder
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_EXTERNAL_IMAGE
+#define TINYGLTF_NO_INCLUDE_JSON
+#include <tiny_gltf.h>
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "util/error.h"
+
+namespace nusselt {
+namespace {
+
+using Json = nlohmann::json;
+
+// Scene files and external buffers above this size are refused rather than read.
+constexpr std::uint64_t kMaxFileBytes = 1ull << 30;
+// A hostile file can instance one large mesh from many nodes; cap the output (~1.3 GB of
+// triangle data) so it fails with a message instead of exhausting memory.
+constexpr std::uint64_t kMaxTriangles = 1ull << 24;
+// Deeper JSON is refused: tinygltf converts extension/extras values recursively.
+constexpr int kMaxJsonDepth = 64;
+
+const char* const kSupportedExtensions[] = {"NUSSELT_brdf", "KHR_lights_punctual",
+                                            "KHR_materials_emissive_strength"};
+
+bool isSupportedExtension(const std::string& name) {
+  for (const char* s : kSupportedExtensions)
+    if (name == s) return true;
+  return false;
+}
+
+std::string supportedExtensionList() {
+  std::string s;
+  for (const char* e : kSupportedExtensions) s += (s.empty() ? "" : ", ") + std::string(e);
+  return s;
+}
+
+std::string str(std::uint64_t v) { return std::to_string(v); }
+std::string str(std::int64_t v) { return std::to_string(v); }
+std::string str(int v) { return std::to_string(v); }
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+std::string quoted(const std::string& s) {
+  // Names come from the file; keep messages one line and bounded.
+  std::string out = "\"";
+  for (char c : s.substr(0, 200)) out += (static_cast<unsigned char>(c) < 0x20) ? '?' : c;
+  if (s.size() > 200) out += "...";
+  return out + "\"";
+}
+
+bool addChecked(std::uint64_t a, std::uint64_t b, std::uint64_t* r) { return !__builtin_add_overflow(a, b, r); }
+bool mulChecked(std::uint64_t a, std::uint64_t b, std::uint64_t* r) { return !__builtin_mul_overflow(a, b, r); }
+
+// ---------------------------------------------------------------------------------------------
+// Files and the scene-folder sandbox.
+
+struct Sandbox {
+  std::string root;  // canonical scene directory; empty: no external files at all
+};
+
+// True when `path` resolves (symlinks followed) to a regular file inside the sandbox, of at most
+// kMaxFileBytes; otherwise `why` says what is wrong.
+bool resolveInside(const Sandbox& box, const std::string& path, std::string* resolved, std::string* why) {
+  if (box.root.empty()) {
+    *why = "external files are not allowed for a scene loaded from memory";
+    return false;
+  }
+  char* real = realpath(path.c_str(), nullptr);
+  if (!real) {
+    *why = std::strerror(errno);
+    return false;
+  }
+  std::string canonical(real);
+  std::free(real);
+  std::string prefix = box.root == "/" ? "/" : box.root + "/";
+  if (canonical.compare(0, prefix.size(), prefix) != 0) {
+    *why = "resolves outside the scene directory";
+    return false;
+  }
+  struct stat st {};
+  if (stat(canonical.c_str(), &st) != 0) {
+    *why = std::strerror(errno);
+    return false;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    *why = "is not a regular file";
+    return false;
+  }
+  if (static_cast<std::uint64_t>(st.st_size) > kMaxFileBytes) {
+    *why = "is larger than the 1 GiB limit";
+    return false;
+  }
+  if (resolved) *resolved = canonical;
+  return true;
+}
+
+// Reads a regular file of at most kMaxFileBytes; `why` explains a failure.
+bool readRegularFile(const std::string& path, std::vector<unsigned char>* out, std::string* why) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0) {
+    *why = std::strerror(errno);
+    return false;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    *why = S_ISDIR(st.st_mode) ? "is a directory" : "is not a regular file";
+    return false;
+  }
+  if (static_cast<std::uint64_t>(st.st_size) > kMaxFileBytes) {
+    *why = "is larger than the 1 GiB limit";
+    return false;
+  }
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) {
+    *why = std::strerror(errno);
+    return false;
+  }
+  out->resize(static_cast<std::size_t>(st.st_size));
+  std::size_t got = out->empty() ? 0 : std::fread(out->data(), 1, out->size(), f);
+  bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed || got != out->size()) {
+    *why = "read error (file changed while reading?)";
+    return false;
+  }
+  return true;
+}
+
+// tinygltf file-system callbacks: no shell expansion, sandboxed reads, no writes.
+bool fsFileExists(const std::string& path, void* user) {
+  std::string why;
+  return resolveInside(*static_cast<Sandbox*>(user), path, nullptr, &why);
+}
+
+std::string fsExpandFilePath(const std::string& path, void*) { return path; }
+
+bool fsReadWholeFile(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  std::string resolved, why;
+  if (!resolveInside(*static_cast<Sandbox*>(user), path, &resolved, &why) ||
+      !readRegularFile(resolved, out, &why)) {
+    if (err) *err += why;
+    return false;
+  }
+  return true;
+}
+
+bool fsWriteWholeFile(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "writing is disabled";
+  return false;
+}
+
+// Images are removed before tinygltf parses (see the top of this file); this is a safety net
+// that accepts without decoding should one slip through.
+bool ignoreImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
+                 void*) {
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// GLB container.
+
+struct GlbParts {
+  std::string json;
+  const unsigned char* bin = nullptr;
+  std::uint64_t binSize = 0;
+  bool hasBin = false;
+};
+
+std::uint32_t readU32(const unsigned char* p) {
+  return std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
+}
+
+void putU32(std::vector<unsigned char>& out, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) out.push_back(static_cast<unsigned char>(v >> (8 * i)));
+}
+
+GlbParts splitGlb(const unsigned char* bytes, std::uint64_t size, const std::string& name) {
+  const std::string where = name + ": GLB: ";
+  if (size < 12) throw Error(where + "truncated: " + str(size) + " bytes, the header alone is 12");
+  std::uint32_t version = readU32(bytes + 4), length = readU32(bytes + 8);
+  if (version != 2) throw Error(where + "version " + str(std::uint64_t(version)) + " is not supported (expected 2)");
+  if (length > size)
+    throw Error(where + "truncated: the header declares " + str(std::uint64_t(length)) + " bytes but the file has " +
+                str(size));
+  if (length < 20) throw Error(where + "truncated: no room for the JSON chunk (length " + str(std::uint64_t(length)) + ")");
+  std::uint64_t jsonLength = readU32(bytes + 12);
+  if (readU32(bytes + 16) != 0x4E4F534Au) throw Error(where + "the first chunk is not JSON");
+  if (20 + jsonLength > length)
+    throw Error(where + "truncated: the JSON chunk (" + str(jsonLength) + " bytes) extends past the end (length " +
+                str(std::uint64_t(length)) + ")");
+  GlbParts parts;
+  parts.json.assign(reinterpret_cast<const char*>(bytes + 20), static_cast<std::size_t>(jsonLength));
+  // Chunks are 4-byte aligned; tolerate a writer that forgot the JSON padding.
+  std::uint64_t offset = 20 + jsonLength;
+  offset = (offset + 3) & ~std::uint64_t(3);
+  if (offset + 8 <= length) {
+    std::uint64_t binLength = readU32(bytes + offset);
+    std::uint32_t type = readU32(bytes + offset + 4);
+    if (type == 0x004E4942u) {
+      if (offset + 8 + binLength > length)
+        throw Error(where + "truncated: the BIN chunk (" + str(binLength) + " bytes) extends past the end (length " +
+                    str(std::uint64_t(length)) + ")");
+      parts.bin = bytes + offset + 8;
+      parts.binSize = binLength;
+      parts.hasBin = binLength > 0;
+    }
+  }
+  return parts;
+}
+
+// ---------------------------------------------------------------------------------------------
+// JSON pre-pass.
+
+// Maximum bracket nesting outside strings; cheap, and runs before any recursive code sees it.
+int jsonDepth(const std::string& text) {
+  int depth = 0, maxDepth = 0;
+  bool inString = false, escaped = false;
+  for (char c : text) {
+    if (inString) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      maxDepth = std::max(maxDepth, ++depth);
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return maxDepth;
+}
+
+// tinygltf only decodes these media types; any other data: URI it would try to open as a file.
+const char* const kDataUriPrefixes[] = {"data:application/octet-stream;base64,",
+                                        "data:application/gltf-buffer;base64,"};
+
+void checkUnsignedFields(const Json& root, const char* array, std::initializer_list<const char*> fields,
+                         const std::string& name) {
+  auto it = root.find(array);
+  if (it == root.end() || !it->is_array()) return;
+  for (std::size_t i = 0; i < it->size(); ++i) {
+    const Json& item = (*it)[i];
+    if (!item.is_object()) throw Error(name + ": " + array + "[" + str(std::uint64_t(i)) + "] is not an object");
+    for (const char* field : fields) {
+      auto f = item.find(field);
+      if (f != item.end() && !f->is_number_unsigned())
+        throw Error(name + ": " + array + "[" + str(std::uint64_t(i)) + "]." + field + ": " + f->dump() +
+                    " is not a non-negative integer");
+    }
+  }
+}
+
+// Checks buffers[i].uri against the sandbox; data URIs must decode to exactly byteLength bytes.
+void checkBufferUris(const Json& root, const Sandbox& box, const std::string& name) {
+  auto buffers = root.find("buffers");
+  if (buffers == root.end() || !buffers->is_array()) return;
+  for (std::size_t i = 0; i < buffers->size(); ++i) {
+    const Json& b = (*buffers)[i];
+    auto u = b.find("uri");
+    if (u == b.end()) continue;
+    const std::string field = name + ": buffers[" + str(std::uint64_t(i)) + "].uri";
+    if (!u->is_string()) throw Error(field + ": not a string");
+    const std::string& uri = u->get_ref<const std::string&>();
+    std::uint64_t byteLength = b.value("byteLength", Json(0)).is_number_unsigned() ? b["byteLength"].get<std::uint64_t>() : 0;
+    if (uri.compare(0, 5, "data:") == 0) {
+      const char* prefix = nullptr;
+      for (const char* p : kDataUriPrefixes)
+        if (uri.compare(0, std::strlen(p), p) == 0) prefix = p;
+      if (!prefix)
+        throw Error(field + ": unsupported data URI (expected data:application/octet-stream;base64, or "
+                            "data:application/gltf-buffer;base64,)");
+      std::string decoded = tinygltf::base64_decode(uri.substr(std::strlen(prefix)));
+      if (decoded.size() != byteLength)
+        throw Error(field + ": the data URI holds " + str(std::uint64_t(decoded.size())) + " bytes but byteLength is " +
+                    str(byteLength));
+      continue;
+    }
+    std::string shown = quoted(uri);
+    if (box.root.empty())
+      throw Error(field + " " + shown + ": external URIs are refused for a scene loaded from memory");
+    std::size_t colon = uri.find(':'), slash = uri.find('/');
+    if (colon != std::string::npos && (slash == std::string::npos || colon < slash))
+      throw Error(field + " " + shown + ": URI schemes are not supported (use a relative path inside the scene directory)");
+    std::string path = tinygltf::dlib::urldecode(uri);
+    if (path.empty()) throw Error(field + ": empty URI");
+    if (path[0] == '/' || path[0] == '\\')
+      throw Error(field + " " + shown + ": absolute paths are refused (use a path relative to the scene file)");
+    if (path.find('\0') != std::string::npos) throw Error(field + " " + shown + ": contains a NUL character");
+    std::size_t start = 0;
+    while (start <= path.size()) {
+      std::size_t end = path.find_first_of("/\\", start);
+      if (end == std::string::npos) end = path.size();
+      if (path.compare(start, end - start, "..") == 0 && end - start == 2)
+        throw Error(field + " " + shown + ": \"..\" would leave the scene directory");
+      start = end + 1;
+    }
+    std::string why;
+    if (!resolveInside(box, box.root + "/" + path, nullptr, &why)) throw Error(field + " " + shown + ": " + why);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Model -> Scene.
+
+struct AccessorData {
+  const unsigned char* base = nullptr;
+  std::uint64_t stride = 0;
+  std::uint64_t count = 0;
+  int componentType = 0;
+};
+
+const char* componentTypeName(int t) {
+  switch (t) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return "5120 (byte)";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "5121 (unsigned byte)";
+    case TINYGLTF_COMPONENT_TYPE_SHORT: return "5122 (short)";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "5123 (unsigned short)";
+    case TINYGLTF_COMPONENT_TYPE_INT: return "5124 (int)";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "5125 (unsigned int)";
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return "5126 (float)";
+    case TINYGLTF_COMPONENT_TYPE_DOUBLE: return "5130 (double)";
+    default: return "unknown";
+  }
+}
+
+const char* typeName(int t) {
+  switch (t) {
+    case TINYGLTF_TYPE_SCALAR: return "SCALAR";
+    case TINYGLTF_TYPE_VEC2: return "VEC2";
+    case TINYGLTF_TYPE_VEC3: return "VEC3";
+    case TINYGLTF_TYPE_VEC4: return "VEC4";
+    case TINYGLTF_TYPE_MAT2: return "MAT2";
+    case TINYGLTF_TYPE_MAT3: return "MAT3";
+    case TINYGLTF_TYPE_MAT4: return "MAT4";
+    default: return "unknown";
+  }
+}
+
+const char* modeName(int mode) {
+  switch (mode) {
+    case TINYGLTF_MODE_POINTS: return "POINTS (0)";
+    case TINYGLTF_MODE_LINE: return "LINES (1)";
+    case TINYGLTF_MODE_LINE_LOOP: return "LINE_LOOP (2)";
+    case TINYGLTF_MODE_LINE_STRIP: return "LINE_STRIP (3)";
+    default: return "invalid";
+  }
+}
+
+bool allFinite(const std::vector<double>& v) {
+  for (double x : v)
+    if (!std::isfinite(x)) return false;
+  return true;
+}
+
+class Converter {
+ public:
+  Converter(const tinygltf::Model& model, const std::string& name, const LoadOptions& options, Scene& scene)
+      : model_(model), name_(name), options_(options), scene_(scene) {}
+
+  void run() {
+    checkExtensionLists();
+    checkModelFeatures();
+    for (std::size_t i = 0; i < model_.materials.size(); ++i) scene_.materials.push_back(convertMaterial(int(i)));
+    traverse();
+    chooseCamera();
+  }
+
+ private:
+  struct CameraInstance {
+    int camera;
+    int node;
+    glm::dmat4 world;
+  };
+
+  const tinygltf::Model& model_;
+  const std::string& name_;
+  const LoadOptions& options_;
+  Scene& scene_;
+  std::set<std::string> warned_;
+  std::set<std::string> seenExtensions_;  // used by materials/nodes, for the extensionsUsed check
+  int defaultMaterial_ = -1;
+  std::vector<CameraInstance> cameras_;
+
+  [[noreturn]] void fail(const std::string& what) const { throw Error(name_ + ": " + what); }
+
+  void warnOnce(const std::string& text) {
+    if (warned_.insert(text).second) scene_.warnings.push_back(name_ + ": " + text);
+  }
+
+  static std::string at(const char* array, std::int64_t i) { return std::string(array) + "[" + str(i) + "]"; }
+
+  void checkIndex(int index, std::size_t size, const std::string& field, const char* what) const {
+    if (index < 0 || static_cast<std::size_t>(index) >= size)
+      fail(field + ": " + str(index) + " is out of range (the file has " + str(std::uint64_t(size)) + " " + what + ")");
+  }
+
+  // ---- extensions and unsupported features ----
+
+  void checkExtensionLists() {
+    for (const std::string& e : model_.extensionsRequired)
+      if (!isSupportedExtension(e))
+        fail("extensionsRequired: " + quoted(e) + " is not supported (supported: " + supportedExtensionList() + ")");
+    for (const std::string& e : model_.extensionsUsed)
+      if (!isSupportedExtension(e)) warnOnce("extension " + e + " is not supported; ignored");
+  }
+
+  void checkDeclared() {
+    for (const std::string& e : seenExtensions_)
+      if (std::find(model_.extensionsUsed.begin(), model_.extensionsUsed.end(), e) == model_.extensionsUsed.end())
+        warnOnce("extension " + e + " is used but not declared in extensionsUsed");
+  }
+
+  void checkModelFeatures() {
+    if (!model_.textures.empty() || !model_.samplers.empty())
+      warnOnce("textures are not supported yet; materials use their constant factors");
+    if (!model_.skins.empty()) warnOnce("skins are not supported; skinned meshes are drawn in their bind pose");
+    if (!model_.animations.empty()) warnOnce("animations are not supported; the static pose is rendered");
+    if (model_.scenes.size() > 1) warnOnce("the file has " + str(std::uint64_t(model_.scenes.size())) +
+                                           " scenes; only the default one is rendered");
+  }
+
+  // ---- materials ----
+
+  ParamValue toParamValue(const tinygltf::Value& v, const std::string& where) const {
+    if (v.IsNumber()) return ParamValue::num(v.GetNumberAsDouble());
+    if (v.IsString()) return ParamValue::str(v.Get<std::string>());
+    if (v.IsArray()) {
+      ParamValue p;
+      p.kind = ParamValue::Kind::Array;
+      for (std::size_t i = 0; i < v.ArrayLen(); ++i) p.items.push_back(toParamValue(v.Get(int(i)), where));
+      return p;
+    }
+    throw Error(where + ": must be a number, a string or an array");
+  }
+
+  Material convertMaterial(int index) {
+    const tinygltf::Material& gm = model_.materials[std::size_t(index)];
+    const std::string field = at("materials", index) + (gm.name.empty() ? "" : " " + quoted(gm.name));
+    Material m;
+    m.name = gm.name.empty() ? at("materials", index) : gm.name;
+
+    for (const auto& [ext, value] : gm.extensions) {
+      seenExtensions_.insert(ext);
+      if (!isSupportedExtension(ext)) warnOnce("extension " + ext + " is not supported; ignored");
+    }
+    auto textured = [&](int textureIndex, const char* slot) {
+      if (textureIndex >= 0) warnOnce(std::string("textures are not supported yet (") + slot + " ignored)");
+    };
+    textured(gm.pbrMetallicRoughness.baseColorTexture.index, "baseColorTexture");
+    textured(gm.pbrMetallicRoughness.metallicRoughnessTexture.index, "metallicRoughnessTexture");
+    textured(gm.normalTexture.index, "normalTexture");
+    textured(gm.occlusionTexture.index, "occlusionTexture");
+    textured(gm.emissiveTexture.index, "emissiveTexture");
+    if (!gm.alphaMode.empty() && gm.alphaMode != "OPAQUE")
+      warnOnce("alphaMode " + gm.alphaMode + " is not supported; materials are opaque");
+
+    auto brdf = gm.extensions.find("NUSSELT_brdf");
+    if (brdf != gm.extensions.end()) {
+      const std::string context = name_ + ": " + field + " NUSSELT_brdf";
+      const tinygltf::Value& v = brdf->second;
+      std::string known;
+      for (const ModelSpec& s : allModels()) known += (known.empty() ? "" : ", ") + s.name;
+      if (!v.IsObject()) throw Error(context + ": must be an object {\"model\": ..., \"params\": {...}}");
+      if (!v.Has("model") || !v.Get("model").IsString())
+        throw Error(context + ": \"model\" must be a string (known models: " + known + ")");
+      const std::string modelName = v.Get("model").Get<std::string>();
+      const ModelSpec* spec = findModel(modelName);
+      if (!spec) throw Error(context + ": unknown model " + quoted(modelName) + " (known models: " + known + ")");
+      NamedParams params;
+      if (v.Has("params")) {
+        const tinygltf::Value& p = v.Get("params");
+        if (!p.IsObject()) throw Error(context + ": \"params\" must be an object");
+        for (const std::string& key : p.Keys())
+          params.emplace_back(key, toParamValue(p.Get(key), context + ": parameter " + quoted(key)));
+      }
+      m.model = spec->id;
+      m.params = packParams(*spec, params, context);
+    } else {
+      // Without NUSSELT_brdf a glTF PBR material becomes Lambertian with rho =
+      // pbrMetallicRoughness.baseColorFactor.rgb clamped to [0, 1]. metallicFactor,
+      // roughnessFactor and alpha are ignored: there is no metal or glossy model in the default
+      // mapping yet, and the diffuse reading of the base colour is the energy-conserving choice.
+      const std::vector<double>& c = gm.pbrMetallicRoughness.baseColorFactor;
+      if (c.size() != 4 || !allFinite(c))
+        fail(field + ".pbrMetallicRoughness.baseColorFactor: expected 4 finite numbers");
+      ParamValue rho;
+      rho.kind = ParamValue::Kind::Array;
+      for (int k = 0; k < 3; ++k) rho.items.push_back(ParamValue::num(std::clamp(c[std::size_t(k)], 0.0, 1.0)));
+      m.model = MODEL_LAMBERT;
+      m.params = packParams(*findModel("lambert"), {{"rho", rho}}, name_ + ": " + field);
+    }
+
+    const std::vector<double>& e = gm.emissiveFactor;
+    if (e.size() != 3) fail(field + ".emissiveFactor: expected 3 numbers");
+    for (double x : e)
+      if (!std::isfinite(x) || x < 0) fail(field + ".emissiveFactor: " + fmt(x) + " is not a finite number >= 0");
+    double strength = 1.0;
+    auto es = gm.extensions.find("KHR_materials_emissive_strength");
+    if (es != gm.extensions.end()) {
+      const std::string esField = field + " KHR_materials_emissive_strength.emissiveStrength";
+      if (!es->second.IsObject()) fail(field + " KHR_materials_emissive_strength: must be an object");
+      if (es->second.Has("emissiveStrength")) {
+        const tinygltf::Value& s = es->second.Get("emissiveStrength");
+        if (!s.IsNumber()) fail(esField + ": must be a number");
+        strength = s.GetNumberAsDouble();
+        if (!std::isfinite(strength) || strength < 0) fail(esField + ": " + fmt(strength) + " is not a finite number >= 0");
+      }
+    }
+    glm::dvec3 emission = glm::dvec3(e[0], e[1], e[2]) * strength;
+    if (!std::isfinite(emission.x) || !std::isfinite(emission.y) || !std::isfinite(emission.z))
+      fail(field + ": emissiveFactor x emissiveStrength overflows");
+    m.emission = glm::vec3(emission);
+    return m;
+  }
+
+  std::uint32_t defaultMaterial() {
+    if (defaultMaterial_ < 0) {
+      Material m;
+      m.name = "default";
+      m.model = MODEL_LAMBERT;
+      ParamValue rho = ParamValue::num(0.8);
+      m.params = packParams(*findModel("lambert"), {{"rho", rho}}, "default material");
+      defaultMaterial_ = int(scene_.materials.size());
+      scene_.materials.push_back(m);
+    }
+    return std::uint32_t(defaultMaterial_);
+  }
+
+  // ---- node hierarchy ----
+
+  glm::dmat4 localTransform(int index) const {
+    const tinygltf::Node& n = model_.nodes[std::size_t(index)];
+    const std::string field = at("nodes", index);
+    if (!n.matrix.empty()) {
+      if (n.matrix.size() != 16 || !allFinite(n.matrix)) fail(field + ".matrix: expected 16 finite numbers");
+      glm::dmat4 m;
+      for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) m[c][r] = n.matrix[std::size_t(4 * c + r)];  // column-major, as glm
+      return m;
+    }
+    glm::dmat4 m(1.0);
+    if (!n.translation.empty()) {
+      if (n.translation.size() != 3 || !allFinite(n.translation))
+        fail(field + ".translation: expected 3 finite numbers");
+      m[3] = glm::dvec4(n.translation[0], n.translation[1], n.translation[2], 1.0);
+    }
+    if (!n.rotation.empty()) {
+      if (n.rotation.size() != 4 || !allFinite(n.rotation)) fail(field + ".rotation: expected 4 finite numbers");
+      glm::dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);  // glTF: x, y, z, w
+      double len = glm::length(q);
+      if (!(len > 1e-12) || !std::isfinite(len)) fail(field + ".rotation: the quaternion has zero length");
+      m = m * glm::mat4_cast(q / len);
+    }
+    if (!n.scale.empty()) {
+      if (n.scale.size() != 3 || !allFinite(n.scale)) fail(field + ".scale: expected 3 finite numbers");
+      m = m * glm::dmat4(glm::dvec4(n.scale[0], 0, 0, 0), glm::dvec4(0, n.scale[1], 0, 0),
+                         glm::dvec4(0, 0, n.scale[2], 0), glm::dvec4(0, 0, 0, 1));
+    }
+    return m;
+  }
+
+  void traverse() {
+    const std::size_t nodeCount = model_.nodes.size();
+    // glTF requires disjoint strict trees: at most one parent per node. With that checked, a
+    // node reached twice in the walk below can only mean a cycle.
+    std::vector<int> parent(nodeCount, -1);
+    for (std::size_t i = 0; i < nodeCount; ++i) {
+      for (int child : model_.nodes[i].children) {
+        checkIndex(child, nodeCount, at("nodes", std::int64_t(i)) + ".children", "nodes");
+        if (parent[std::size_t(child)] >= 0 || std::size_t(child) == i)
+          fail(at("nodes", child) + " has more than one parent (nodes[" + str(parent[std::size_t(child)] < 0 ? int(i) : parent[std::size_t(child)]) +
+               "] and nodes[" + str(std::int64_t(i)) + "]); the node hierarchy must be a tree");
+        parent[std::size_t(child)] = int(i);
+      }
+    }
+    std::vector<int> roots;
+    if (!model_.scenes.empty()) {
+      int s = model_.defaultScene >= 0 ? model_.defaultScene : 0;
+      checkIndex(s, model_.scenes.size(), "scene", "scenes");
+      const std::string field = at("scenes", s) + ".nodes";
+      for (int r : model_.scenes[std::size_t(s)].nodes) {
+        checkIndex(r, nodeCount, field, "nodes");
+        roots.push_back(r);
+      }
+    } else {
+      for (std::size_t i = 0; i < nodeCount; ++i)
+        if (parent[i] < 0) roots.push_back(int(i));
+    }
+
+    std::vector<char> visited(nodeCount, 0);
+    std::vector<std::pair<int, glm::dmat4>> stack;
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(*it, glm::dmat4(1.0));
+    while (!stack.empty()) {
+      auto [index, parentWorld] = stack.back();
+      stack.pop_back();
+      if (visited[std::size_t(index)])
+        fail(at("nodes", index) + " is reached twice: the node hierarchy has a cycle or a scene lists a node twice");
+      visited[std::size_t(index)] = 1;
+      glm::dmat4 world = parentWorld * localTransform(index);
+      visitNode(index, world);
+      const std::vector<int>& children = model_.nodes[std::size_t(index)].children;
+      for (auto c = children.rbegin(); c != children.rend(); ++c) stack.emplace_back(*c, world);
+    }
+    checkDeclared();
+  }
+
+  void visitNode(int index, const glm::dmat4& world) {
+    const tinygltf::Node& n = model_.nodes[std::size_t(index)];
+    const std::string field = at("nodes", index);
+    if (n.skin >= 0) warnOnce("skins are not supported; skinned meshes are drawn in their bind pose");
+    if (!n.weights.empty()) warnOnce("morph targets are not supported; base geometry is used");
+    for (const auto& [ext, value] : n.extensions) {
+      seenExtensions_.insert(ext);
+      if (!isSupportedExtension(ext)) warnOnce("extension " + ext + " is not supported; ignored");
+    }
+    if (n.mesh >= 0 || n.mesh < -1) {
+      checkIndex(n.mesh, model_.meshes.size(), field + ".mesh", "meshes");
+      const tinygltf::Mesh& mesh = model_.meshes[std::size_t(n.mesh)];
+      for (std::size_t p = 0; p < mesh.primitives.size(); ++p) addPrimitive(n.mesh, int(p), world);
+    }
+    if (n.camera >= 0 || n.camera < -1) {
+      checkIndex(n.camera, model_.cameras.size(), field + ".camera", "cameras");
+      cameras_.push_back({n.camera, index, world});
+    }
+    auto light = n.extensions.find("KHR_lights_punctual");
+    if (light != n.extensions.end()) addLight(index, light->second, world);
+  }
+
+  // ---- accessors ----
+
+  AccessorData checkAccessor(int index, const std::string& role, std::initializer_list<int> types,
+                             std::initializer_list<int> componentTypes) const {
+    checkIndex(index, model_.accessors.size(), role, "accessors");
+    const tinygltf::Accessor& a = model_.accessors[std::size_t(index)];
+    const std::string where = at("accessors", index) + " (" + role + ")";
+    if (a.sparse.isSparse) fail(where + ": sparse accessors are not supported");
+    if (std::find(types.begin(), types.end(), a.type) == types.end()) {
+      std::string expected;
+      for (int t : types) expected += (expected.empty() ? "" : " or ") + std::string(typeName(t));
+      fail(where + ": type " + typeName(a.type) + ", expected " + expected);
+    }
+    if (std::find(componentTypes.begin(), componentTypes.end(), a.componentType) == componentTypes.end()) {
+      std::string expected;
+      for (int t : componentTypes) expected += (expected.empty() ? "" : " or ") + std::string(componentTypeName(t));
+      fail(where + ": componentType " + componentTypeName(a.componentType) + ", expected " + expected);
+    }
+    // Floats and index types can never be normalized (glTF 2.0, 3.6.2.1 / 3.7.2.1).
+    if (a.normalized) fail(where + ": normalized is true, which is invalid for componentType " +
+                           componentTypeName(a.componentType));
+    AccessorData d;
+    d.componentType = a.componentType;
+    d.count = a.count;
+    if (a.count == 0) return d;
+    if (a.bufferView < 0) fail(where + ": no bufferView (an all-zero accessor); not supported");
+    checkIndex(a.bufferView, model_.bufferViews.size(), where + ": bufferView", "bufferViews");
+    const tinygltf::BufferView& bv = model_.bufferViews[std::size_t(a.bufferView)];
+    const std::string bvField = at("bufferViews", a.bufferView);
+    checkIndex(bv.buffer, model_.buffers.size(), bvField + ".buffer", "buffers");
+    const tinygltf::Buffer& buffer = model_.buffers[std::size_t(bv.buffer)];
+    std::uint64_t bvEnd = 0;
+    if (!addChecked(bv.byteOffset, bv.byteLength, &bvEnd) || bvEnd > buffer.data.size())
+      fail(bvField + ": byteOffset " + str(std::uint64_t(bv.byteOffset)) + " + byteLength " +
+           str(std::uint64_t(bv.byteLength)) + " exceeds buffers[" + str(bv.buffer) + "] (byteLength " +
+           str(std::uint64_t(buffer.data.size())) + ")");
+    const std::uint64_t elementSize =
+        std::uint64_t(tinygltf::GetComponentSizeInBytes(std::uint32_t(a.componentType))) *
+        std::uint64_t(tinygltf::GetNumComponentsInType(std::uint32_t(a.type)));
+    if (bv.byteStride != 0 && bv.byteStride < elementSize)
+      fail(where + ": " + bvField + ".byteStride " + str(std::uint64_t(bv.byteStride)) +
+           " is smaller than the element size " + str(elementSize));
+    d.stride = bv.byteStride != 0 ? bv.byteStride : elementSize;
+    std::uint64_t span = 0, end = 0;
+    if (!mulChecked(d.stride, a.count - 1, &span) || !addChecked(span, elementSize, &span) ||
+        !addChecked(span, a.byteOffset, &end) || end > bv.byteLength)
+      fail(where + ": byteOffset " + str(std::uint64_t(a.byteOffset)) + " + count " + str(std::uint64_t(a.count)) +
+           " x stride " + str(d.stride) + " exceeds " + bvField + " (byteLength " + str(std::uint64_t(bv.byteLength)) +
+           ")");
+    d.base = buffer.data.data() + bv.byteOffset + a.byteOffset;
+    return d;
+  }
+
+  static glm::vec3 readVec3(const AccessorData& d, std::uint64_t i) {
+    float v[3];
+    std::memcpy(v, d.base + i * d.stride, sizeof v);  // memcpy: buffers need not be aligned
+    return glm::vec3(v[0], v[1], v[2]);
+  }
+
+  static std::uint32_t readIndex(const AccessorData& d, std::uint64_t i) {
+    const unsigned char* p = d.base + i * d.stride;
+    switch (d.componentType) {
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return p[0];
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        std::uint16_t v;
+        std::memcpy(&v, p, 2);
+        return v;
+      }
+      default: {
+        std::uint32_t v;
+        std::memcpy(&v, p, 4);
+        return v;
+      }
+    }
+  }
+
+  // ---- primitives ----
+
+  void addPrimitive(int meshIndex, int primIndex, const glm::dmat4& world) {
+    const tinygltf::Primitive& prim = model_.meshes[std::size_t(meshIndex)].primitives[std::size_t(primIndex)];
+    const std::string pname = at("meshes", meshIndex) + "." + at("primitives", primIndex);
+    if (!prim.targets.empty()) warnOnce("morph targets are not supported; base geometry is used");
+    for (const auto& [ext, value] : prim.extensions)
+      warnOnce("extension " + ext + " is not supported; ignored");
+    const int mode = prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+      if (mode >= 0 && mode <= 3)
+        warnOnce(std::string("primitives with mode ") + modeName(mode) + " are not supported; skipped");
+      else
+        warnOnce(pname + ".mode: " + str(mode) + " is not a valid primitive mode; skipped");
+      return;
+    }
+    auto posIt = prim.attributes.find("POSITION");
+    if (posIt == prim.attributes.end()) {
+      warnOnce(pname + " has no POSITION attribute; skipped");
+      return;
+    }
+    const AccessorData pos = checkAccessor(posIt->second, "POSITION of " + pname, {TINYGLTF_TYPE_VEC3},
+                                           {TINYGLTF_COMPONENT_TYPE_FLOAT});
+    AccessorData nrm;
+    bool hasNormals = false;
+    auto nIt = prim.attributes.find("NORMAL");
+    if (nIt != prim.attributes.end()) {
+      nrm = checkAccessor(nIt->second, "NORMAL of " + pname, {TINYGLTF_TYPE_VEC3}, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+      if (nrm.count != pos.count)
+        fail(at("accessors", nIt->second) + " (NORMAL of " + pname + "): count " + str(nrm.count) +
+             " differs from the POSITION count " + str(pos.count));
+      hasNormals = true;
+    }
+    AccessorData idx;
+    const bool indexed = prim.indices >= 0 || prim.indices < -1;
+    std::uint64_t cornerCount = pos.count;
+    if (indexed) {
+      idx = checkAccessor(prim.indices, "indices of " + pname, {TINYGLTF_TYPE_SCALAR},
+                          {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT});
+      cornerCount = idx.count;
+      for (std::uint64_t i = 0; i < idx.count; ++i) {
+        std::uint32_t v = readIndex(idx, i);
+        if (v >= pos.count)
+          fail(at("accessors", prim.indices) + " (indices of " + pname + "): index " + str(std::uint64_t(v)) +
+               " (element " + str(i) + ") is out of range for " + str(pos.count) + " vertices");
+      }
+    }
+    std::uint32_t material;
+    if (prim.material == -1) {
+      material = defaultMaterial();
+    } else {
+      checkIndex(prim.material, model_.materials.size(), pname + ".material", "materials");
+      material = std::uint32_t(prim.material);
+    }
+
+    std::uint64_t triangles = 0;
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      if (cornerCount % 3 != 0)
+        warnOnce(pname + ": " + str(cornerCount) + " vertices is not a multiple of 3; the remainder is ignored");
+      triangles = cornerCount / 3;
+    } else {
+      triangles = cornerCount >= 3 ? cornerCount - 2 : 0;
+    }
+    if (scene_.triangleCount() + scene_.droppedTriangles + triangles > kMaxTriangles)
+      fail(pname + ": the scene exceeds " + str(kMaxTriangles) + " triangles");
+    auto corner = [&](std::uint64_t k) -> std::uint64_t { return indexed ? readIndex(idx, k) : k; };
+
+    const glm::dmat3 linear(world);
+    const double det = glm::determinant(linear);
+    const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(linear));
+    // A mirroring transform reverses the winding; swapping two corners keeps the geometric
+    // normal on the same side as the (inverse-transpose transformed) shading normal.
+    const bool flip = det < 0;
+
+    scene_.positions.reserve(scene_.positions.size() + 3 * triangles);
+    scene_.normals.reserve(scene_.normals.size() + 3 * triangles);
+    scene_.triangleMaterial.reserve(scene_.triangleMaterial.size() + triangles);
+    for (std::uint64_t t = 0; t < triangles; ++t) {
+      std::uint64_t c[3];
+      if (mode == TINYGLTF_MODE_TRIANGLES) {
+        c[0] = corner(3 * t), c[1] = corner(3 * t + 1), c[2] = corner(3 * t + 2);
+      } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        // glTF 2.0 3.7.2.1: odd triangles swap their first two corners to keep the winding.
+        if (t % 2 == 0) c[0] = corner(t), c[1] = corner(t + 1), c[2] = corner(t + 2);
+        else c[0] = corner(t + 1), c[1] = corner(t), c[2] = corner(t + 2);
+      } else {
+        c[0] = corner(t + 1), c[1] = corner(t + 2), c[2] = corner(0);
+      }
+      if (flip) std::swap(c[1], c[2]);
+      glm::vec3 p[3];
+      bool finite = true;
+      for (int k = 0; k < 3; ++k) {
+        p[k] = glm::vec3(world * glm::dvec4(glm::dvec3(readVec3(pos, c[k])), 1.0));
+        finite = finite && std::isfinite(p[k].x) && std::isfinite(p[k].y) && std::isfinite(p[k].z);
+      }
+      // In float, as the renderer computes it: a zero cross product has no geometric normal.
+      glm::vec3 g = glm::cross(p[1] - p[0], p[2] - p[0]);
+      float g2 = glm::dot(g, g);
+      if (!finite || !std::isfinite(g2) || !(g2 > 0.0f)) {
+        ++scene_.droppedTriangles;
+        continue;
+      }
+      glm::vec3 gn = glm::vec3(glm::normalize(glm::dvec3(g)));
+      for (int k = 0; k < 3; ++k) {
+        glm::vec3 n = gn;
+        if (hasNormals) {
+          glm::dvec3 m = normalMatrix * glm::dvec3(readVec3(nrm, c[k]));
+          double len = glm::length(m);
+          if (std::isfinite(len) && len > 0) n = glm::vec3(m / len);
+        }
+        scene_.positions.push_back(p[k]);
+        scene_.normals.push_back(n);
+      }
+      scene_.triangleMaterial.push_back(material);
+    }
+  }
+
+  // ---- lights ----
+
+  void addLight(int nodeIndex, const tinygltf::Value& ext, const glm::dmat4& world) {
+    const std::string field = at("nodes", nodeIndex) + ".extensions.KHR_lights_punctual";
+    if (!ext.IsObject() || !ext.Has("light") || !ext.Get("light").IsInt())
+      fail(field + ": expected {\"light\": <index>}");
+    int li = ext.Get("light").Get<int>();
+    checkIndex(li, model_.lights.size(), field + ".light", "KHR_lights_punctual lights");
+    const tinygltf::Light& gl = model_.lights[std::size_t(li)];
+    const std::string lfield = "KHR_lights_punctual.lights[" + str(li) + "]";
+    PunctualLight l;
+    l.name = gl.name.empty() ? lfield : gl.name;
+    if (gl.type == "point") l.type = LightType::Point;
+    else if (gl.type == "spot") l.type = LightType::Spot;
+    else if (gl.type == "directional") l.type = LightType::Directional;
+    else fail(lfield + ".type: " + quoted(gl.type) + " (expected point, spot or directional)");
+    glm::dvec3 colour(1.0);
+    if (!gl.color.empty()) {
+      if (gl.color.size() != 3) fail(lfield + ".color: expected 3 numbers");
+      for (int k = 0; k < 3; ++k) {
+        double c = gl.color[std::size_t(k)];
+        if (!std::isfinite(c) || c < 0) fail(lfield + ".color: " + fmt(c) + " is not a finite number >= 0");
+        colour[k] = c;
+      }
+    }
+    if (!std::isfinite(gl.intensity) || gl.intensity < 0)
+      fail(lfield + ".intensity: " + fmt(gl.intensity) + " is not a finite number >= 0");
+    glm::dvec3 intensity = colour * gl.intensity;
+    if (!std::isfinite(intensity.x) || !std::isfinite(intensity.y) || !std::isfinite(intensity.z))
+      fail(lfield + ": color x intensity overflows");
+    l.intensity = glm::vec3(intensity);
+    if (l.type == LightType::Spot) {
+      double inner = gl.spot.innerConeAngle, outer = gl.spot.outerConeAngle;
+      if (!std::isfinite(inner) || !std::isfinite(outer) || inner < 0 || outer <= inner || outer > M_PI / 2 + 1e-9)
+        fail(lfield + ".spot: innerConeAngle " + fmt(inner) + " and outerConeAngle " + fmt(outer) +
+             " must satisfy 0 <= inner < outer <= pi/2");
+      l.innerConeAngle = float(inner);
+      l.outerConeAngle = float(outer);
+    }
+    glm::dvec3 position(world * glm::dvec4(0, 0, 0, 1));
+    glm::dvec3 direction = glm::dmat3(world) * glm::dvec3(0, 0, -1);
+    double len = glm::length(direction);
+    if (!std::isfinite(position.x) || !std::isfinite(position.y) || !std::isfinite(position.z))
+      fail(at("nodes", nodeIndex) + ": the light position is not finite");
+    if (!(len > 0) || !std::isfinite(len)) {
+      if (l.type != LightType::Point) fail(at("nodes", nodeIndex) + ": the light direction is degenerate (zero scale?)");
+      direction = glm::dvec3(0, 0, -1);
+    } else {
+      direction /= len;
+    }
+    l.position = glm::vec3(position);
+    l.direction = glm::vec3(direction);
+    scene_.lights.push_back(l);
+  }
+
+  // ---- camera ----
+
+  std::string cameraLabel(const CameraInstance& ci) const {
+    const tinygltf::Camera& c = model_.cameras[std::size_t(ci.camera)];
+    if (!c.name.empty()) return c.name;
+    const tinygltf::Node& n = model_.nodes[std::size_t(ci.node)];
+    return n.name.empty() ? at("cameras", ci.camera) : n.name;
+  }
+
+  void chooseCamera() {
+    if (cameras_.empty()) {
+      if (!options_.cameraName.empty())
+        fail("--camera " + quoted(options_.cameraName) + ": the scene has no camera instanced by a node");
+      scene_.hasCamera = false;
+      scene_.camera = frameScene(scene_);
+      return;
+    }
+    const CameraInstance* chosen = &cameras_.front();
+    if (!options_.cameraName.empty()) {
+      chosen = nullptr;
+      // The camera's own name first, then the name of the node that instances it.
+      for (const CameraInstance& ci : cameras_)
+        if (!chosen && model_.cameras[std::size_t(ci.camera)].name == options_.cameraName) chosen = &ci;
+      for (const CameraInstance& ci : cameras_)
+        if (!chosen && model_.nodes[std::size_t(ci.node)].name == options_.cameraName) chosen = &ci;
+      if (!chosen) {
+        std::string names;
+        for (const CameraInstance& ci : cameras_) names += (names.empty() ? "" : ", ") + quoted(cameraLabel(ci));
+        fail("--camera " + quoted(options_.cameraName) + ": no such camera (available: " + names + ")");
+      }
+    }
+    const tinygltf::Camera& gc = model_.cameras[std::size_t(chosen->camera)];
+    const std::string field = at("cameras", chosen->camera);
+    Camera cam;
+    cam.name = cameraLabel(*chosen);
+    if (gc.type == "perspective") {
+      double yfov = gc.perspective.yfov, aspect = gc.perspective.aspectRatio;
+      if (!std::isfinite(yfov) || yfov <= 0 || yfov >= M_PI)
+        fail(field + ".perspective.yfov: " + fmt(yfov) + " is not in (0, pi)");
+      if (!std::isfinite(aspect) || aspect < 0) fail(field + ".perspective.aspectRatio: " + fmt(aspect) + " is not > 0");
+      cam.yfov = float(yfov);
+      cam.aspectRatio = float(aspect);
+    } else if (gc.type == "orthographic") {
+      double xmag = gc.orthographic.xmag, ymag = gc.orthographic.ymag;
+      if (!std::isfinite(xmag) || xmag == 0) fail(field + ".orthographic.xmag: " + fmt(xmag) + " must be finite and non-zero");
+      if (!std::isfinite(ymag) || ymag == 0) fail(field + ".orthographic.ymag: " + fmt(ymag) + " must be finite and non-zero");
+      cam.orthographic = true;
+      cam.xmag = float(std::fabs(xmag));
+      cam.ymag = float(std::fabs(ymag));
+    } else {
+      fail(field + ".type: " + quoted(gc.type) + " (expected perspective or orthographic)");
+    }
+    // glTF cameras look down -z with +y up; scale and shear are removed by Gram-Schmidt.
+    const glm::dmat4& w = chosen->world;
+    glm::dvec3 position(w * glm::dvec4(0, 0, 0, 1));
+    glm::dvec3 forward = glm::dmat3(w) * glm::dvec3(0, 0, -1);
+    glm::dvec3 up = glm::dmat3(w) * glm::dvec3(0, 1, 0);
+    double fl = glm::length(forward);
+    if (!(fl > 0) || !std::isfinite(fl) || !std::isfinite(position.x + position.y + position.z))
+      fail(at("nodes", chosen->node) + ": the camera transform is degenerate");
+    forward /= fl;
+    up -= glm::dot(up, forward) * forward;
+    double ul = glm::length(up);
+    if (!(ul > 1e-12 * fl) || !std::isfinite(ul)) fail(at("nodes", chosen->node) + ": the camera transform is degenerate");
+    up /= ul;
+    cam.position = glm::vec3(position);
+    cam.forward = glm::vec3(forward);
+    cam.up = glm::vec3(up);
+    scene_.camera = cam;
+    scene_.hasCamera = true;
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+
+std::string trimmed(std::string s) {
+  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+  for (char& c : s)
+    if (c == '\n') c = ';';
+  if (s.size() > 500) s = s.substr(0, 500) + "...";
+  return s;
+}
+
+Scene loadImpl(const unsigned char* bytes, std::uint64_t size, const std::string& name, const Sandbox& box,
+               const LoadOptions& options) {
+  if (size > kMaxFileBytes) throw Error(name + ": larger than the 1 GiB limit");
+  const bool binary = size >= 4 && std::memcmp(bytes, "glTF", 4) == 0;
+  GlbParts glb;
+  if (binary) {
+    glb = splitGlb(bytes, size, name);
+  } else {
+    glb.json.assign(reinterpret_cast<const char*>(bytes), static_cast<std::size_t>(size));
+  }
+  if (glb.json.find_first_not_of(" \t\r\n") == std::string::npos)
+    throw Error(name + ": empty file (expected glTF JSON or GLB)");
+  if (jsonDepth(glb.json) > kMaxJsonDepth)
+    throw Error(name + ": JSON is nested deeper than " + str(kMaxJsonDepth) + " levels");
+  Json root;
+  try {
+    root = Json::parse(glb.json);
+  } catch (const Json::exception& e) {
+    throw Error(name + ": malformed JSON: " + e.what());
+  }
+  if (!root.is_object()) throw Error(name + ": the JSON top level is not an object");
+
+  checkUnsignedFields(root, "buffers", {"byteLength"}, name);
+  checkUnsignedFields(root, "bufferViews", {"byteOffset", "byteLength", "byteStride"}, name);
+  checkUnsignedFields(root, "accessors", {"byteOffset", "count"}, name);
+  checkBufferUris(root, box, name);
+  std::vector<std::string> earlyWarnings;
+  if (auto images = root.find("images"); images != root.end()) {
+    std::size_t n = images->is_array() ? images->size() : 0;
+    earlyWarnings.push_back(name + ": images are not supported yet; " + str(std::uint64_t(n)) + " image(s) ignored");
+    root.erase("images");
+  }
+  const std::string json = root.dump();
+
+  tinygltf::TinyGLTF loader;
+  Sandbox sandbox = box;
+  loader.SetFsCallbacks({&fsFileExists, &fsExpandFilePath, &fsReadWholeFile, &fsWriteWholeFile, &sandbox});
+  loader.SetImageLoader(&ignoreImage, nullptr);
+  tinygltf::Model model;
+  std::string err, warn;
+  bool ok;
+  if (binary) {
+    // Re-assemble a GLB around the vetted JSON; the BIN chunk is padded to 4 bytes as tinygltf wants.
+    std::uint64_t jsonPadded = (json.size() + 3) & ~std::uint64_t(3);
+    std::uint64_t binPadded = (glb.binSize + 3) & ~std::uint64_t(3);
+    std::uint64_t total = 12 + 8 + jsonPadded + (glb.hasBin ? 8 + binPadded : 0);
+    if (total > kMaxFileBytes + 64) throw Error(name + ": larger than the 1 GiB limit");
+    std::vector<unsigned char> out;
+    out.reserve(static_cast<std::size_t>(total));
+    out.insert(out.end(), {'g', 'l', 'T', 'F'});
+    putU32(out, 2);
+    putU32(out, std::uint32_t(total));
+    putU32(out, std::uint32_t(jsonPadded));
+    putU32(out, 0x4E4F534Au);
+    out.insert(out.end(), json.begin(), json.end());
+    out.resize(out.size() + (jsonPadded - json.size()), ' ');
+    if (glb.hasBin) {
+      putU32(out, std::uint32_t(binPadded));
+      putU32(out, 0x004E4942u);
+      out.insert(out.end(), glb.bin, glb.bin + glb.binSize);
+      out.resize(out.size() + (binPadded - glb.binSize), 0);
+    }
+    ok = loader.LoadBinaryFromMemory(&model, &err, &warn, out.data(), unsigned(out.size()), box.root);
+  } else {
+    ok = loader.LoadASCIIFromString(&model, &err, &warn, json.c_str(), unsigned(json.size()), box.root);
+  }
+  if (!ok) throw Error(name + ": invalid glTF: " + trimmed(err.empty() ? "tinygltf failed without a message" : err));
+
+  Scene scene;
+  scene.sourcePath = name;
+  scene.warnings = earlyWarnings;
+  std::istringstream warnings(warn);
+  for (std::string line; std::getline(warnings, line);)
+    if (!line.empty()) scene.warnings.push_back(name + ": " + line);
+  Converter(model, name, options, scene).run();
+  return scene;
+}
+
+}  // namespace
+
+Scene loadScene(const std::string& path, const LoadOptions& options) {
+  std::vector<unsigned char> bytes;
+  std::string why;
+  if (!readRegularFile(path, &bytes, &why)) throw Error(path + ": cannot read: " + why);
+  // The sandbox is the canonical directory of the scene file; external buffers must resolve
+  // inside it.
+  std::string dir = path;
+  std::size_t slash = dir.find_last_of('/');
+  dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : dir.substr(0, slash));
+  char* real = realpath(dir.c_str(), nullptr);
+  if (!real) throw Error(path + ": cannot resolve its directory: " + std::strerror(errno));
+  Sandbox box{real};
+  std::free(real);
+  return loadImpl(bytes.data(), bytes.size(), path, box, options);
+}
+
+Scene loadSceneFromMemory(const unsigned char* bytes, std::size_t size, const std::string& displayName,
+                          const LoadOptions& options) {
+  if (!bytes && size) throw Error(displayName + ": no data");
+  static const unsigned char empty = 0;
+  return loadImpl(bytes ? bytes : &empty, size, displayName, Sandbox{}, options);
+}
+
+}  // namespace nusselt

@@ -1,0 +1,35 @@
+// scene.cpp: the default view for scenes without a camera.
+#include "scene/scene.h"
+
+#include <cmath>
+
+namespace nusselt {
+
+Camera frameScene(const Scene& scene) {
+  Camera camera;
+  camera.name = "default";
+  camera.yfov = 0.7853981634f;  // 45 degrees
+  camera.forward = glm::vec3(0.0f, 0.0f, -1.0f);
+  camera.up = glm::vec3(0.0f, 1.0f, 0.0f);
+
+  glm::dvec3 lo(INFINITY), hi(-INFINITY);
+  for (const glm::vec3& p : scene.positions) {
+    lo = glm::min(lo, glm::dvec3(p));
+    hi = glm::max(hi, glm::dvec3(p));
+  }
+  if (scene.positions.empty()) {
+    lo = glm::dvec3(-1.0);
+    hi = glm::dvec3(1.0);
+  }
+  glm::dvec3 centre = 0.5 * (lo + hi);
+  double radius = 0.5 * glm::length(hi - lo);
+  if (!(radius > 0.0) || !std::isfinite(radius)) radius = 1.0;
+  // The bounding sphere fits the vertical field of view at this distance. Using the vertical
+  // angle also frames it horizontally for any aspect ratio >= 1; narrower images may crop the
+  // sides, which is acceptable for a preview view.
+  double distance = radius / std::sin(0.5 * static_cast<double>(camera.yfov));
+  camera.position = glm::vec3(centre + glm::dvec3(0.0, 0.0, distance));
+  return camera;
+}
+
+}  // namespace nusselt

@@ -1,0 +1,97 @@
+// vk.h: the thin Vulkan layer: free functions and plain structs (zeux/niagara style).
+// The loader is opened at run time through volk, so a machine without libvulkan gets a clear
+// message instead of a dynamic-linker error.
+#pragma once
+#include <volk.h>
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace nusselt::vk {
+
+// Checks a VkResult; on failure throws nusselt::Error naming the result, the call, file and line.
+#define VK_CHECK(expr) ::nusselt::vk::check((expr), #expr, __FILE__, __LINE__)
+void check(VkResult result, const char* expr, const char* file, int line);
+const char* resultName(VkResult result);
+
+struct DeviceInfo {
+  std::uint32_t index = 0;
+  std::string name;
+  std::string type;  // "discrete GPU", "integrated GPU", "CPU", ...
+  std::uint32_t apiVersion = 0;
+  bool suitable = false;
+  std::string whyNot;  // when not suitable
+  std::uint64_t deviceLocalBytes = 0;
+};
+
+struct ContextOptions {
+  int deviceIndex = -1;       // -1: choose (discrete GPU first, lavapipe accepted)
+  bool validation = false;    // VK_LAYER_KHRONOS_validation with synchronization validation
+  std::vector<std::string> instanceExtensions;  // e.g. surface extensions for the preview
+  bool swapchain = false;     // enable VK_KHR_swapchain on the device
+};
+
+struct Context {
+  VkInstance instance = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+  VkPhysicalDevice physical = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  std::uint32_t queueFamily = 0;
+  VkCommandPool commandPool = VK_NULL_HANDLE;
+  VkPhysicalDeviceProperties properties{};
+  VkPhysicalDeviceMemoryProperties memory{};
+  std::string deviceName;
+  bool validation = false;
+  // Validation messages (warnings and errors) seen so far; tests require zero.
+  std::atomic<std::uint64_t> validationMessages{0};
+};
+
+// Lists the devices with why each one is or is not usable. Throws when there is no loader.
+std::vector<DeviceInfo> listDevices();
+
+// Creates instance, device and queue. Throws nusselt::Error with a clear message (naming the
+// Debian package to install) when there is no loader, no driver or no suitable device.
+void createContext(Context& ctx, const ContextOptions& options);
+void destroyContext(Context& ctx);
+
+struct Buffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkDeviceSize size = 0;
+  VkDeviceAddress address = 0;
+  void* mapped = nullptr;  // host-visible buffers only
+};
+
+// A storage buffer with a device address. hostVisible: mapped, coherent (for small per-pass
+// data and readback); otherwise device-local. `what` names it in out-of-memory errors.
+Buffer createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags extraUsage, bool hostVisible,
+                    const std::string& what);
+void destroyBuffer(Context& ctx, Buffer& buffer);
+// Copies bytes into a buffer (through a staging buffer when it is not host visible).
+void uploadBuffer(Context& ctx, Buffer& buffer, const void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
+void downloadBuffer(Context& ctx, const Buffer& buffer, void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
+
+// One-shot command buffer: begin, record in `record`, submit and wait.
+VkCommandBuffer beginOneShot(Context& ctx);
+void endOneShot(Context& ctx, VkCommandBuffer cmd);
+
+// The SPIR-V of a stage embedded at build time, by name (e.g. "shade"). Throws if unknown.
+std::vector<std::uint32_t> embeddedShader(const std::string& name);
+
+struct ComputePipeline {
+  std::string name;
+  VkShaderModule module = VK_NULL_HANDLE;
+  VkPipeline pipeline = VK_NULL_HANDLE;
+};
+ComputePipeline createComputePipeline(Context& ctx, VkPipelineLayout layout, const std::string& shaderName,
+                                      const std::vector<std::uint32_t>& specialization = {});
+void destroyComputePipeline(Context& ctx, ComputePipeline& pipeline);
+
+// A global memory barrier between compute dispatches, also making queue counts visible to the
+// indirect-dispatch stage that reads them.
+void computeBarrier(VkCommandBuffer cmd);
+
+}  // namespace nusselt::vk

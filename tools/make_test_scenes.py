@@ -1,0 +1,245 @@
+#!/usr/bin/env python3
+"""Generates the renderer's test scenes in scenes/tests/ (glTF with embedded base64 buffers).
+
+  furnace.gltf   closed unit sphere seen from inside: lambert rho 0.5, emission 1 everywhere;
+                 every pixel converges to Le / (1 - rho) = 2. The pole triangles are zero-area
+                 on purpose (the loader must drop them: 64 of 1024).
+  mis.gltf       a floor under a large dim and a small bright emissive quad (MIS test).
+  punctual.gltf  a floor lit by one point and one spot light (KHR_lights_punctual).
+
+Emissive surfaces are one-sided: they emit on the side of their geometric normal
+(v1 - v0) x (v2 - v0), so every triangle here is wound to face where it should emit or be seen.
+Standard library only; run from anywhere: python3 tools/make_test_scenes.py
+"""
+import base64
+import json
+import math
+import os
+import struct
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+OUT = os.path.join(ROOT, "scenes", "tests")
+
+
+def sub(a, b):
+    return [a[i] - b[i] for i in range(3)]
+
+
+def cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def dot(a, b):
+    return sum(a[i] * b[i] for i in range(3))
+
+
+def normalize(a):
+    n = math.sqrt(dot(a, a))
+    return [x / n for x in a]
+
+
+def look_at_quaternion(eye, target, up=(0.0, 1.0, 0.0)):
+    """Rotation (x, y, z, w) turning a glTF camera (looking down -z, +y up) towards target."""
+    f = normalize(sub(target, eye))
+    z = [-c for c in f]
+    x = normalize(cross(list(up), z))
+    y = cross(z, x)
+    m = [[x[0], y[0], z[0]], [x[1], y[1], z[1]], [x[2], y[2], z[2]]]  # columns x, y, z
+    tr = m[0][0] + m[1][1] + m[2][2]
+    if tr > 0:
+        s = math.sqrt(tr + 1.0) * 2
+        w, qx, qy, qz = 0.25 * s, (m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s
+    elif m[0][0] > m[1][1] and m[0][0] > m[2][2]:
+        s = math.sqrt(1.0 + m[0][0] - m[1][1] - m[2][2]) * 2
+        w, qx, qy, qz = (m[2][1] - m[1][2]) / s, 0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s
+    elif m[1][1] > m[2][2]:
+        s = math.sqrt(1.0 + m[1][1] - m[0][0] - m[2][2]) * 2
+        w, qx, qy, qz = (m[0][2] - m[2][0]) / s, (m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s
+    else:
+        s = math.sqrt(1.0 + m[2][2] - m[0][0] - m[1][1]) * 2
+        w, qx, qy, qz = (m[1][0] - m[0][1]) / s, (m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s
+    return [qx, qy, qz, w]
+
+
+class Builder:
+    """Accumulates meshes into one buffer and emits a glTF document."""
+
+    def __init__(self):
+        self.data = bytearray()
+        self.doc = {
+            "asset": {"version": "2.0", "generator": "nusselt tools/make_test_scenes.py"},
+            "scene": 0,
+            "scenes": [{"nodes": []}],
+            "nodes": [],
+            "meshes": [],
+            "materials": [],
+            "accessors": [],
+            "bufferViews": [],
+            "buffers": [],
+            "extensionsUsed": [],
+        }
+
+    def use(self, ext):
+        if ext not in self.doc["extensionsUsed"]:
+            self.doc["extensionsUsed"].append(ext)
+
+    def _view(self, payload, target):
+        while len(self.data) % 4:
+            self.data.append(0)
+        offset = len(self.data)
+        self.data += payload
+        self.doc["bufferViews"].append(
+            {"buffer": 0, "byteOffset": offset, "byteLength": len(payload), "target": target})
+        return len(self.doc["bufferViews"]) - 1
+
+    def _vec3_accessor(self, values, with_bounds):
+        payload = b"".join(struct.pack("<3f", *v) for v in values)
+        acc = {"bufferView": self._view(payload, 34962), "componentType": 5126, "count": len(values),
+               "type": "VEC3"}
+        if with_bounds:
+            # min/max of the float32 values, as the spec requires for POSITION
+            f = [struct.unpack("<3f", struct.pack("<3f", *v)) for v in values]
+            acc["min"] = [min(p[i] for p in f) for i in range(3)]
+            acc["max"] = [max(p[i] for p in f) for i in range(3)]
+        self.doc["accessors"].append(acc)
+        return len(self.doc["accessors"]) - 1
+
+    def material(self, name, rho, emission=(0.0, 0.0, 0.0), strength=None):
+        self.use("NUSSELT_brdf")
+        mat = {"name": name,
+               "pbrMetallicRoughness": {"baseColorFactor": [rho, rho, rho, 1.0], "metallicFactor": 0.0},
+               "extensions": {"NUSSELT_brdf": {"model": "lambert", "params": {"rho": [rho, rho, rho]}}}}
+        if any(emission):
+            mat["emissiveFactor"] = list(emission)
+        if strength is not None:
+            self.use("KHR_materials_emissive_strength")
+            mat["extensions"]["KHR_materials_emissive_strength"] = {"emissiveStrength": strength}
+        self.doc["materials"].append(mat)
+        return len(self.doc["materials"]) - 1
+
+    def mesh(self, name, positions, normals, indices, material):
+        pos = self._vec3_accessor(positions, True)
+        nrm = self._vec3_accessor(normals, False)
+        payload = b"".join(struct.pack("<I", i) for i in indices)
+        while len(payload) % 4:
+            payload += b"\0"
+        self.doc["accessors"].append({"bufferView": self._view(payload, 34963), "componentType": 5125,
+                                      "count": len(indices), "type": "SCALAR"})
+        ind = len(self.doc["accessors"]) - 1
+        self.doc["meshes"].append({"name": name, "primitives": [
+            {"attributes": {"POSITION": pos, "NORMAL": nrm}, "indices": ind, "material": material, "mode": 4}]})
+        self.node({"name": name, "mesh": len(self.doc["meshes"]) - 1})
+
+    def quad(self, name, corners, material):
+        """corners in counter-clockwise order seen from the front (the emitting side)."""
+        n = normalize(cross(sub(corners[1], corners[0]), sub(corners[2], corners[0])))
+        self.mesh(name, corners, [n] * 4, [0, 1, 2, 0, 2, 3], material)
+
+    def node(self, node):
+        self.doc["nodes"].append(node)
+        self.doc["scenes"][0]["nodes"].append(len(self.doc["nodes"]) - 1)
+
+    def camera(self, name, eye, target, yfov, aspect=None):
+        persp = {"yfov": yfov, "znear": 0.01}
+        if aspect:
+            persp["aspectRatio"] = aspect
+        self.doc.setdefault("cameras", []).append({"name": name, "type": "perspective", "perspective": persp})
+        node = {"name": name, "camera": len(self.doc["cameras"]) - 1, "translation": list(eye)}
+        if target is not None:
+            node["rotation"] = look_at_quaternion(eye, target)
+        self.node(node)
+
+    def light(self, name, light, translation, rotation=None):
+        self.use("KHR_lights_punctual")
+        ext = self.doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {"lights": []})
+        light = dict(light, name=name)
+        ext["lights"].append(light)
+        node = {"name": name, "translation": list(translation),
+                "extensions": {"KHR_lights_punctual": {"light": len(ext["lights"]) - 1}}}
+        if rotation:
+            node["rotation"] = rotation
+        self.node(node)
+
+    def write(self, filename):
+        while len(self.data) % 4:
+            self.data.append(0)
+        self.doc["buffers"] = [{"byteLength": len(self.data),
+                                "uri": "data:application/octet-stream;base64," +
+                                       base64.b64encode(bytes(self.data)).decode("ascii")}]
+        if not self.doc["extensionsUsed"]:
+            del self.doc["extensionsUsed"]
+        os.makedirs(OUT, exist_ok=True)
+        path = os.path.join(OUT, filename)
+        with open(path, "w") as f:
+            json.dump(self.doc, f, indent=1)
+            f.write("\n")
+        print("wrote", os.path.relpath(path, ROOT))
+
+
+def furnace():
+    b = Builder()
+    rows, cols = 16, 32
+    positions, normals = [], []
+    for i in range(rows + 1):
+        theta = math.pi * i / rows
+        for j in range(cols + 1):
+            phi = 2 * math.pi * j / cols
+            if i == 0 or i == rows:
+                # exact poles: the pole triangles are exactly zero-area (the loader drops them)
+                p = [0.0, 1.0 if i == 0 else -1.0, 0.0]
+            else:
+                p = [math.sin(theta) * math.cos(phi), math.cos(theta), math.sin(theta) * math.sin(phi)]
+            positions.append(p)
+            normals.append([-c for c in p])  # inward: the camera is inside
+    indices = []
+    for i in range(rows):
+        for j in range(cols):
+            a, c = i * (cols + 1) + j, (i + 1) * (cols + 1) + j
+            for tri in ((a, a + 1, c), (a + 1, c + 1, c)):
+                p0, p1, p2 = (positions[k] for k in tri)
+                g = cross(sub(p1, p0), sub(p2, p0))
+                centroid = [(p0[k] + p1[k] + p2[k]) / 3 for k in range(3)]
+                if dot(g, centroid) > 0:  # outward: reverse to face the centre
+                    tri = (tri[0], tri[2], tri[1])
+                indices.extend(tri)
+    # check: every non-degenerate triangle faces inward
+    for t in range(0, len(indices), 3):
+        p0, p1, p2 = (positions[k] for k in indices[t:t + 3])
+        g = cross(sub(p1, p0), sub(p2, p0))
+        assert dot(g, g) == 0 or dot(g, [(p0[k] + p1[k] + p2[k]) for k in range(3)]) < 0
+    mat = b.material("furnace", 0.5, emission=(1.0, 1.0, 1.0))
+    b.mesh("sphere", positions, normals, indices, mat)
+    b.camera("centre", (0.0, 0.0, 0.0), None, 1.0)
+    b.write("furnace.gltf")
+
+
+def mis():
+    b = Builder()
+    floor = b.material("floor", 0.5)
+    large = b.material("large_dim", 0.0, emission=(0.5, 0.5, 0.5))
+    small = b.material("small_bright", 0.0, emission=(1.0, 1.0, 1.0), strength=50.0)
+    # floor y = 0 facing +y (counter-clockwise seen from above)
+    b.quad("floor", [[-2, 0, -2], [-2, 0, 2], [2, 0, 2], [2, 0, -2]], floor)
+    # emitters at y = 1.5 facing down (-y): counter-clockwise seen from below
+    b.quad("large_dim", [[-1.5, 1.5, -0.6], [-0.25, 1.5, -0.6], [-0.25, 1.5, 0.4], [-1.5, 1.5, 0.4]], large)
+    b.quad("small_bright", [[0.7, 1.5, -0.15], [0.8, 1.5, -0.15], [0.8, 1.5, -0.05], [0.7, 1.5, -0.05]], small)
+    b.camera("camera", (0.0, 1.0, 4.0), (0.0, 0.2, 0.0), 0.8, 1.0)
+    b.write("mis.gltf")
+
+
+def punctual():
+    b = Builder()
+    floor = b.material("floor", 0.5)
+    b.quad("floor", [[-2, 0, -2], [-2, 0, 2], [2, 0, 2], [2, 0, -2]], floor)
+    b.light("point", {"type": "point", "color": [1.0, 1.0, 1.0], "intensity": 2.0}, (-1.0, 1.0, 0.0))
+    s = math.sqrt(0.5)  # -90 degrees about x: the node's -z points down
+    b.light("spot", {"type": "spot", "color": [1.0, 0.9, 0.8], "intensity": 5.0,
+                     "spot": {"innerConeAngle": 0.3, "outerConeAngle": 0.5}}, (1.0, 1.5, 0.0), [-s, 0.0, 0.0, s])
+    b.camera("camera", (0.0, 3.0, 5.0), (0.0, 0.0, 0.0), 0.7, 1.0)
+    b.write("punctual.gltf")
+
+
+if __name__ == "__main__":
+    furnace()
+    mis()
+    punctual()
