@@ -105,17 +105,30 @@ double hemisphere(const G& g, double thetaI, double phiI, AlbedoMethod method, d
   };
   std::vector<double> sBreaks = gradedBreaks(0.0, 1.0, sM);
   std::vector<double> pBreaks = gradedBreaks(phiM - pi, phiM + pi, phiM);
-  const double innerRel = relTol * 1e-2, absFloor = 1e-13;
-  if (method == AlbedoMethod::ThetaOuter) {
-    auto outer = [&](double s) {
-      return adaptive([&](double phi) { return integrand(s, phi); }, pBreaks, innerRel, absFloor, 400);
-    };
-    return adaptive(outer, sBreaks, relTol, absFloor, 400);
+  // Also the axes (anisotropic lobes are aligned with x and y; at normal incidence the mirror
+  // azimuth says nothing).
+  for (int k = -4; k <= 4; ++k) {
+    double a = k * 0.5 * pi;
+    if (a > phiM - pi && a < phiM + pi) pBreaks.push_back(a);
   }
-  auto outer = [&](double phi) {
-    return adaptive([&](double s) { return integrand(s, phi); }, sBreaks, innerRel, absFloor, 400);
+  std::sort(pBreaks.begin(), pBreaks.end());
+  // Float evaluation noise is ~1e-7 relative: no tolerance below that. The inner integrals get an
+  // absolute tolerance relative to the whole (a coarse first pass gives its scale).
+  auto nested = [&](double outerRel, double innerRel, double innerAbs, int maxPieces) {
+    if (method == AlbedoMethod::ThetaOuter) {
+      auto outer = [&](double s) {
+        return adaptive([&](double phi) { return integrand(s, phi); }, pBreaks, innerRel, innerAbs, maxPieces);
+      };
+      return adaptive(outer, sBreaks, outerRel, innerAbs, maxPieces);
+    }
+    auto outer = [&](double phi) {
+      return adaptive([&](double s) { return integrand(s, phi); }, sBreaks, innerRel, innerAbs, maxPieces);
+    };
+    return adaptive(outer, pBreaks, outerRel, innerAbs, maxPieces);
   };
-  return adaptive(outer, pBreaks, relTol, absFloor, 400);
+  double coarse = std::abs(nested(1e-3, 1e-4, 0.0, 60));
+  if (coarse == 0.0) return 0.0;
+  return nested(relTol, 2e-7, 0.1 * relTol * coarse, 300);
 }
 
 vec3 incident(double thetaDeg, double phiDeg) {
@@ -124,7 +137,7 @@ vec3 incident(double thetaDeg, double phiDeg) {
               static_cast<float>(std::cos(t)));
 }
 
-constexpr double kRelTol = 1e-7;
+constexpr double kRelTol = 1e-6;
 
 }  // namespace
 

@@ -252,6 +252,30 @@ int benchRenderCommand(const BenchArgs& a) {
   return kExitOk;
 }
 
+int infoCommand(const std::vector<std::string>& files) {
+  for (const std::string& f : files) {
+    ImageMetadata meta;
+    Image img = readExr(f, &meta);
+    double sum[3] = {0, 0, 0};
+    for (std::size_t i = 0; i < img.rgb.size(); ++i) sum[i % 3] += img.rgb[i];
+    double n = double(img.width) * img.height;
+    std::printf("%s: %dx%d, mean RGB %.6g %.6g %.6g%s\n", f.c_str(), img.width, img.height, sum[0] / n, sum[1] / n,
+                sum[2] / n, img.variance.empty() ? "" : ", with variance channels");
+    for (auto& [k, v] : meta.strings) std::printf("  %s: %s\n", k.c_str(), v.c_str());
+    for (auto& [k, v] : meta.ints) std::printf("  %s: %lld\n", k.c_str(), static_cast<long long>(v));
+    for (auto& [k, v] : meta.doubles) std::printf("  %s: %.6g\n", k.c_str(), v);
+  }
+  return kExitOk;
+}
+
+int diffCommand(const std::string& a, const std::string& b) {
+  Image ia = readExr(a), ib = readExr(b);
+  ImageDifference d = compareImages(ia, ib);
+  std::printf("relMSE %.6g  MSE %.6g  mean %.6g (%s) vs %.6g (%s)  max |diff| %.6g\n", d.relMse, d.mse, d.meanA,
+              a.c_str(), d.meanB, b.c_str(), d.maxAbs);
+  return kExitOk;
+}
+
 }  // namespace
 
 int runCli(int argc, char** argv) {
@@ -296,6 +320,14 @@ int runCli(int argc, char** argv) {
   benchRender->add_option("--height", ba.height, "Image height")->capture_default_str()->check(CLI::Range(1u, 65536u));
   benchRender->add_option("--device", ba.device, "Vulkan device index");
 
+  std::vector<std::string> infoFiles;
+  CLI::App* info = app.add_subcommand("info", "Print the size, mean and header attributes of OpenEXR images");
+  info->add_option("files", infoFiles, "EXR files")->required();
+  std::string diffA, diffB;
+  CLI::App* diff = app.add_subcommand("diff", "Compare two EXR images: relMSE (reference = second), MSE, means, max difference");
+  diff->add_option("image", diffA, "Image")->required();
+  diff->add_option("reference", diffB, "Reference image")->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -306,6 +338,8 @@ int runCli(int argc, char** argv) {
     if (*render) return renderCommand(ra);
     if (*devices) return devicesCommand();
     if (*benchRender) return benchRenderCommand(ba);
+    if (*info) return infoCommand(infoFiles);
+    if (*diff) return diffCommand(diffA, diffB);
   } catch (const Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return kExitFailure;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <system_error>
 #include <thread>
 
 namespace nusselt {
@@ -54,8 +55,8 @@ struct Prim {
   std::uint32_t id;
   glm::vec3 hi;
   std::uint32_t pad;
-  // Twice the box centre: the factor 2 is irrelevant to binning and saves a multiply.
-  glm::vec3 centre2() const { return lo + hi; }
+  // Halves first: lo + hi overflows for coordinates beyond 1.7e38.
+  glm::vec3 centre() const { return lo * 0.5f + hi * 0.5f; }
 };
 
 // A child reference as its parent stores it.
@@ -99,9 +100,10 @@ std::uint32_t medianLevels(std::uint32_t n) {
 
 // The bin of a centre coordinate. One function for binning and partitioning so that both see
 // bit-identical results.
+// Clamps in float before converting: casting a NaN or out-of-range float to int is undefined.
 inline int binOf(float c, float cmin, float scale) {
-  int b = static_cast<int>((c - cmin) * scale);
-  return std::min(std::max(b, 0), kBins - 1);
+  const float f = (c - cmin) * scale;
+  return f > 0.0f ? (f < static_cast<float>(kBins) ? static_cast<int>(f) : kBins - 1) : 0;
 }
 
 class Builder {
@@ -119,7 +121,7 @@ class Builder {
     for (std::uint32_t i = begin; i < end; ++i) {
       ref.box.grow(prims_[i].lo);
       ref.box.grow(prims_[i].hi);
-      centres.grow(prims_[i].centre2());
+      centres.grow(prims_[i].centre());
     }
 
     Split split;
@@ -144,11 +146,13 @@ class Builder {
       const float scale = binScale(centres, split.axis);
       const int axis = split.axis, bin = split.bin;
       Prim* m = std::partition(prims_ + begin, prims_ + end, [&](const Prim& p) {
-        return binOf(p.centre2()[axis], cmin, scale) < bin;
+        return binOf(p.centre()[axis], cmin, scale) < bin;
       });
       mid = static_cast<std::uint32_t>(m - prims_);
     }
-    if (mid == begin || mid == end) {
+    // (The count check is paranoia: binOf is deterministic, so the partition reproduces the
+    // binning; if it ever did not, the depth reasoning above would not hold for this split.)
+    if (!sahFits || mid - begin != split.countLeft) {
       // No usable SAH split (coincident centres, or the depth cap is near): split at the median
       // along the longest centre axis. With coincident centres this is a split by index; either
       // way both halves shrink by half, which is what keeps the depth bounded.
@@ -156,7 +160,7 @@ class Builder {
       const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
       mid = begin + n / 2;
       std::nth_element(prims_ + begin, prims_ + mid, prims_ + end, [axis](const Prim& a, const Prim& b) {
-        return a.centre2()[axis] < b.centre2()[axis];
+        return a.centre()[axis] < b.centre()[axis];
       });
     }
 
@@ -166,19 +170,26 @@ class Builder {
     ref.count = 0;
 
     ChildRef left, right;
+    std::vector<BvhNode> rightNodes;
+    LocalStats rightStats;
+    std::exception_ptr error;
+    std::thread worker;
     if (depth < parallelDepth_ && n >= kParallelMinTriangles) {
       // Right subtree on another thread into its own node array, appended after the left subtree:
       // the same depth-first layout as a serial build, so the result is thread-count independent.
-      std::vector<BvhNode> rightNodes;
-      LocalStats rightStats;
-      std::exception_ptr error;
-      std::thread worker([&] {
-        try {
-          right = build(mid, end, depth + 1, rightNodes, rightStats);
-        } catch (...) {
-          error = std::current_exception();
-        }
-      });
+      try {
+        worker = std::thread([&] {
+          try {
+            right = build(mid, end, depth + 1, rightNodes, rightStats);
+          } catch (...) {
+            error = std::current_exception();
+          }
+        });
+      } catch (const std::system_error&) {
+        // No thread to be had (resource limits): build this subtree serially instead.
+      }
+    }
+    if (worker.joinable()) {
       try {
         left = build(begin, mid, depth + 1, out, stats);
       } catch (...) {
@@ -217,7 +228,8 @@ class Builder {
  private:
   static float binScale(const Aabb& centres, int axis) {
     const float extent = centres.hi[axis] - centres.lo[axis];
-    return extent > 0.0f ? static_cast<float>(kBins) / extent : 0.0f;
+    // 0 (axis skipped) when flat, or when the extent overflows (coordinates near the float limit).
+    return extent > 0.0f && std::isfinite(extent) ? static_cast<float>(kBins) / extent : 0.0f;
   }
 
   Split findSahSplit(std::uint32_t begin, std::uint32_t end, const Aabb& box, const Aabb& centres) const {
@@ -233,7 +245,7 @@ class Builder {
     }
     for (std::uint32_t i = begin; i < end; ++i) {
       const Prim& p = prims_[i];
-      const glm::vec3 c = p.centre2();
+      const glm::vec3 c = p.centre();
       for (int a = 0; a < 3; ++a) {
         Bin& bin = bins[a][binOf(c[a], cmin[a], scale[a])];
         bin.box.lo = glm::min(bin.box.lo, p.lo);

@@ -314,11 +314,11 @@ void checkBufferUris(const Json& root, const Sandbox& box, const std::string& na
       continue;
     }
     std::string shown = quoted(uri);
-    if (box.root.empty())
-      throw Error(field + " " + shown + ": external URIs are refused for a scene loaded from memory");
     std::size_t colon = uri.find(':'), slash = uri.find('/');
     if (colon != std::string::npos && (slash == std::string::npos || colon < slash))
       throw Error(field + " " + shown + ": URI schemes are not supported (use a relative path inside the scene directory)");
+    if (box.root.empty())
+      throw Error(field + " " + shown + ": external URIs are refused for a scene loaded from memory");
     std::string path = tinygltf::dlib::urldecode(uri);
     if (path.empty()) throw Error(field + ": empty URI");
     if (path[0] == '/' || path[0] == '\\')

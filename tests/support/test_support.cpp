@@ -63,37 +63,69 @@ int binomialUpperLimit(int n, double p, double alpha) {
   return k;
 }
 
-std::string compareImagesStatistically(const Image& a, const Image& b, double pixelAlpha, double alpha) {
+std::string compareImagesStatistically(const Image& a, const Image& b, double cellAlpha, double alpha, int block,
+                                       double referenceVarianceScale) {
   if (a.width != b.width || a.height != b.height) return "image sizes differ";
-  const int n = a.width * a.height;
-  int failures = 0;
-  double worstZ = 0;
-  int worstPixel = -1;
-  for (int i = 0; i < n; ++i) {
-    // Luminance of each estimate; its variance from the channel variances (channels treated as
-    // perfectly correlated: an upper bound, conservative for the test).
-    const double w[3] = {0.2126, 0.7152, 0.0722};
-    double ma = 0, mb = 0, sa = 0, sb = 0;
-    for (int c = 0; c < 3; ++c) {
-      ma += w[c] * a.rgb[3 * i + c];
-      mb += w[c] * b.rgb[3 * i + c];
-      sa += w[c] * std::sqrt(std::max(0.0f, a.variance.empty() ? 0.0f : a.variance[3 * i + c]));
-      sb += w[c] * std::sqrt(std::max(0.0f, b.variance.empty() ? 0.0f : b.variance[3 * i + c]));
+  if (a.variance.empty() || b.variance.empty()) return "both images need variance channels";
+  const int bw = (a.width + block - 1) / block, bh = (a.height + block - 1) / block;
+  const double w[3] = {0.2126, 0.7152, 0.0722};
+  int failures = 0, cells = 0;
+  double totalDiff = 0, totalVar = 0;
+  double worstZ = 0, worstA = 0, worstB = 0, worstVa = 0, worstVb = 0;
+  int worstX = -1, worstY = -1;
+  for (int by = 0; by < bh; ++by)
+    for (int bx = 0; bx < bw; ++bx) {
+      // Luminance of each block mean; its variance from the channel variances, the channels of a
+      // pixel treated as perfectly correlated (an upper bound: conservative), pixels independent.
+      double ma = 0, mb = 0, va = 0, vb = 0;
+      int k = 0;
+      for (int y = by * block; y < std::min(a.height, (by + 1) * block); ++y)
+        for (int x = bx * block; x < std::min(a.width, (bx + 1) * block); ++x) {
+          int i = y * a.width + x;
+          double sa = 0, sb = 0;
+          for (int c = 0; c < 3; ++c) {
+            ma += w[c] * a.rgb[3 * i + c];
+            mb += w[c] * b.rgb[3 * i + c];
+            double vaPixel = referenceVarianceScale > 0 ? referenceVarianceScale * b.variance[3 * i + c] : a.variance[3 * i + c];
+            sa += w[c] * std::sqrt(std::max(0.0, vaPixel));
+            sb += w[c] * std::sqrt(std::max(0.0f, b.variance[3 * i + c]));
+          }
+          va += sa * sa;
+          vb += sb * sb;
+          ++k;
+        }
+      ++cells;
+      totalDiff += ma - mb;
+      totalVar += va + vb;
+      double var = (va + vb) / (double(k) * k);
+      double diff = (ma - mb) / k;
+      double z = var > 0 ? diff / std::sqrt(var) : (diff == 0 ? 0.0 : INFINITY);
+      if (normalPValue(z) < cellAlpha) ++failures;
+      if (std::fabs(z) > worstZ) {
+        worstZ = std::fabs(z);
+        worstX = bx * block;
+        worstY = by * block;
+        worstA = ma / k;
+        worstB = mb / k;
+        worstVa = va / (double(k) * k);
+        worstVb = vb / (double(k) * k);
+      }
     }
-    double var = sa * sa + sb * sb;
-    double z = var > 0 ? (ma - mb) / std::sqrt(var) : (ma == mb ? 0.0 : INFINITY);
-    if (normalPValue(z) < pixelAlpha) ++failures;
-    if (std::fabs(z) > worstZ) {
-      worstZ = std::fabs(z);
-      worstPixel = i;
-    }
-  }
-  int limit = binomialUpperLimit(n, pixelAlpha, alpha);
-  if (failures <= limit) return "";
+  int limit = binomialUpperLimit(cells, cellAlpha, alpha);
   std::ostringstream os;
-  os << failures << " of " << n << " pixels fail the per-pixel z-test at p < " << pixelAlpha << " (at most " << limit
-     << " expected at significance " << alpha << "); worst |z| = " << worstZ << " at pixel (" << worstPixel % a.width
-     << ", " << worstPixel / a.width << ")";
+  // The whole-image mean, tested too: it has by far the smallest variance, so it catches a small
+  // bias spread over the image (a missing bounce) that no single cell can resolve.
+  const double zImage = totalDiff / std::sqrt(totalVar);
+  if (normalPValue(zImage) < alpha) {
+    os << "the image means differ: z = " << zImage << " (p < " << alpha << "); mean luminance difference "
+       << totalDiff / (double(a.width) * a.height);
+    return os.str();
+  }
+  if (failures <= limit) return "";
+  os << failures << " of " << cells << " cells of " << block << "x" << block << " pixels fail the z-test at p < "
+     << cellAlpha << " (at most " << limit << " expected at significance " << alpha << "); worst |z| = " << worstZ
+     << " at pixel (" << worstX << ", " << worstY << "): luminance " << worstA << " (variance " << worstVa << ") vs "
+     << worstB << " (variance " << worstVb << ")";
   return os.str();
 }
 

@@ -31,10 +31,20 @@ double normalQuantileUpper(double p);
 // Smallest k such that P(Binomial(n, p) > k) <= alpha.
 int binomialUpperLimit(int n, double p, double alpha);
 
-// Per-pixel Welch z-test of two independent estimates (means and variances of the mean).
-// A pixel fails when its two-sided p-value is below pixelAlpha; the test passes when the number
-// of failing pixels is within binomialUpperLimit(pixels, pixelAlpha, alpha). Returns a message
+// Welch z-test of two independent estimates (means and variances of the mean), per block of
+// block x block pixels (block = 1: per pixel). Averaging a block sums many samples, which makes
+// the z statistic close to normal even for heavy-tailed estimators (BSDF sampling of a small
+// light), where a per-pixel test with a 100-sample variance estimate is not.
+// A block fails when its two-sided p-value is below cellAlpha; the test passes when the number
+// of failing blocks is within binomialUpperLimit(blocks, cellAlpha, alpha). Returns a message
 // describing the outcome (empty on success).
-std::string compareImagesStatistically(const Image& a, const Image& b, double pixelAlpha, double alpha);
+//
+// referenceVarianceScale > 0: b is a reference of the same estimator with many more samples, and
+// a's variance is taken as b's times this scale (= reference spp / a's spp) instead of a's own
+// estimate. Under the null hypothesis both have the same per-sample variance, and the
+// reference's estimate is the precise one: a low-spp estimate misses rare bright samples (a
+// pixel that partly covers a light) exactly when its mean is low, which inflates |z|.
+std::string compareImagesStatistically(const Image& a, const Image& b, double cellAlpha, double alpha, int block = 1,
+                                       double referenceVarianceScale = 0);
 
 }  // namespace nusselt::test

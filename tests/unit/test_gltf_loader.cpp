@@ -396,7 +396,7 @@ TEST(GltfLoaderErrors, IndexOutOfRange) {
 TEST(GltfLoaderErrors, UnknownModel) {
   std::string e = fileError("unknown_model.gltf");
   EXPECT_HAS(e, "unknown_model.gltf: materials[0] \"Floor\" NUSSELT_brdf");
-  EXPECT_HAS(e, "unknown model \"phong\"");
+  EXPECT_HAS(e, "unknown model \"no_such_model\"");
   EXPECT_HAS(e, "lambert");
 }
 
