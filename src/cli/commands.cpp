@@ -282,6 +282,8 @@ int runCli(int argc, char** argv) {
   CLI::App app{"nusselt: a physically based renderer with generic BRDF sampling on Vulkan compute"};
   app.set_version_flag("--version", NUSSELT_VERSION);
   app.require_subcommand(1);
+  // A repeated option takes its last value (scripts can append overrides).
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
 
   RenderArgs ra;
   CLI::App* render = app.add_subcommand("render", "Render a glTF scene (default: the built-in Cornell box) to OpenEXR");
