@@ -1074,6 +1074,23 @@ Scene loadImpl(const unsigned char* bytes, std::uint64_t size, const std::string
   return scene;
 }
 
+// nusselt::Error is the only exception callers handle; library exceptions that escape the
+// checks above (a JSON type error, an allocation failure) still name the file.
+template <typename F>
+Scene guarded(const std::string& name, F&& load) {
+  try {
+    return load();
+  } catch (const Error&) {
+    throw;
+  } catch (const Json::exception& e) {
+    throw Error(name + ": invalid glTF: " + e.what());
+  } catch (const std::bad_alloc&) {
+    throw Error(name + ": out of memory while loading");
+  } catch (const std::length_error& e) {
+    throw Error(name + ": out of memory while loading (" + e.what() + ")");
+  }
+}
+
 }  // namespace
 
 Scene loadScene(const std::string& path, const LoadOptions& options) {
@@ -1089,14 +1106,14 @@ Scene loadScene(const std::string& path, const LoadOptions& options) {
   if (!real) throw Error(path + ": cannot resolve its directory: " + std::strerror(errno));
   Sandbox box{real};
   std::free(real);
-  return loadImpl(bytes.data(), bytes.size(), path, box, options);
+  return guarded(path, [&] { return loadImpl(bytes.data(), bytes.size(), path, box, options); });
 }
 
 Scene loadSceneFromMemory(const unsigned char* bytes, std::size_t size, const std::string& displayName,
                           const LoadOptions& options) {
   if (!bytes && size) throw Error(displayName + ": no data");
   static const unsigned char empty = 0;
-  return loadImpl(bytes ? bytes : &empty, size, displayName, Sandbox{}, options);
+  return guarded(displayName, [&] { return loadImpl(bytes ? bytes : &empty, size, displayName, Sandbox{}, options); });
 }
 
 }  // namespace nusselt

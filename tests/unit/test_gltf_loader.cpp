@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -573,6 +574,23 @@ TEST(GltfLoaderErrors, MutatedGlbNeverCrashes) {
     for (int k = 0; k < flips; ++k) bytes[next() % bytes.size()] = static_cast<unsigned char>(next() >> 24);
     try {
       loadSceneFromMemory(bytes.data(), bytes.size(), "mutated.glb");
+    } catch (const Error&) {
+    }
+  }
+}
+
+// The same for the JSON text: characters replaced by JSON punctuation and digits.
+TEST(GltfLoaderErrors, MutatedJsonNeverCrashes) {
+  std::vector<unsigned char> original = readBytes(kData + "lights.gltf");
+  const std::string alphabet = "{}[]\",:-0123456789e.9";
+  std::uint32_t seed = 777;
+  auto next = [&] { return seed = seed * 1664525u + 1013904223u; };
+  for (int round = 0; round < 300; ++round) {
+    std::vector<unsigned char> bytes = original;
+    int flips = 1 + int(next() % 4);
+    for (int k = 0; k < flips; ++k) bytes[next() % bytes.size()] = static_cast<unsigned char>(alphabet[next() % alphabet.size()]);
+    try {
+      loadSceneFromMemory(bytes.data(), bytes.size(), "mutated.gltf");
     } catch (const Error&) {
     }
   }
