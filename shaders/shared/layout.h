@@ -175,7 +175,7 @@ struct Globals {
   BUFREF(UVec4s) dispatchArgs; // QUEUE_COUNT DispatchArgs
   BUFREF(Uints) stats;         // STAT_COUNT counters
   BUFREF(Floats) tables;       // model tables (albedo tables, quadtrees) addressed by offsets
-  BUFREF(Uints) pad0;
+  BUFREF(Uints) display;       // the preview's RGBA8 display buffer (0 when headless)
 };
 STATIC_ASSERT_SIZE(Globals, 48 + 7 * 16 + 22 * 8);
 

@@ -239,7 +239,7 @@ void Renderer::uploadScene(const Scene& scene) {
   g.stats = m_stats->address;
   float zero = 0.0f;
   g.tables = make(4, "tables", &zero)->address;
-  g.pad0 = 0;
+  g.display = 0;
 
   // Film starts at zero.
   VkCommandBuffer cmd = vk::beginOneShot(m_ctx);
@@ -247,22 +247,7 @@ void Renderer::uploadScene(const Scene& scene) {
   vkCmdFillBuffer(cmd, m_filmSq->buffer, 0, VK_WHOLE_SIZE, 0);
   vk::endOneShot(m_ctx, cmd);
 
-  // ---- Camera ----
-  Camera cam = scene.hasCamera ? scene.camera : frameScene(scene);
-  glm::vec3 f = glm::normalize(cam.forward);
-  glm::vec3 right = glm::normalize(glm::cross(f, cam.up));
-  glm::vec3 up = glm::cross(right, f);
-  float aspect = float(m_settings.width) / float(m_settings.height);
-  g.camPosition = v4(cam.position, cam.orthographic ? 1.0f : 0.0f);
-  g.camForward = v4(f);
-  if (cam.orthographic) {
-    g.camRight = v4(right * cam.xmag);
-    g.camUp = v4(up * cam.ymag);
-  } else {
-    float th = std::tan(0.5f * cam.yfov);
-    g.camRight = v4(right * (th * aspect));
-    g.camUp = v4(up * th);
-  }
+  m_cameraState = scene.hasCamera ? scene.camera : frameScene(scene);
   g.sceneSphere = glm::vec4(centre, radius);
   g.lightTotal = glm::vec4(float(total), 0, 0, 0);
   g.background = v4(scene.background);
@@ -272,7 +257,45 @@ void Renderer::uploadScene(const Scene& scene) {
                         static_cast<std::uint32_t>(triCount), static_cast<std::uint32_t>(m_settings.lighting));
   m_globals.resize(sizeof(Globals));
   std::memcpy(m_globals.data(), &g, sizeof g);
+  writeCamera(m_cameraState);
   m_globalsBuffer = vk::createBuffer(m_ctx, sizeof(Globals), 0, true, "globals");
+}
+
+void Renderer::writeCamera(const Camera& cam) {
+  Globals* g = reinterpret_cast<Globals*>(m_globals.data());
+  glm::vec3 f = glm::normalize(cam.forward);
+  glm::vec3 right = glm::normalize(glm::cross(f, cam.up));
+  glm::vec3 up = glm::cross(right, f);
+  float aspect = float(m_settings.width) / float(m_settings.height);
+  g->camPosition = v4(cam.position, cam.orthographic ? 1.0f : 0.0f);
+  g->camForward = v4(f);
+  if (cam.orthographic) {
+    g->camRight = v4(right * cam.xmag);
+    g->camUp = v4(up * cam.ymag);
+  } else {
+    float th = std::tan(0.5f * cam.yfov);
+    g->camRight = v4(right * (th * aspect));
+    g->camUp = v4(up * th);
+  }
+}
+
+void Renderer::reset() {
+  VkCommandBuffer cmd = vk::beginOneShot(m_ctx);
+  vkCmdFillBuffer(cmd, m_film->buffer, 0, VK_WHOLE_SIZE, 0);
+  vkCmdFillBuffer(cmd, m_filmSq->buffer, 0, VK_WHOLE_SIZE, 0);
+  vk::endOneShot(m_ctx, cmd);
+  m_samples = 0;
+}
+
+void Renderer::setCamera(const Camera& camera) {
+  m_cameraState = camera;
+  writeCamera(camera);
+  reset();
+}
+
+void Renderer::setDisplayBuffer(VkDeviceAddress address) {
+  reinterpret_cast<Globals*>(m_globals.data())->display = address;
+  std::memcpy(m_globalsBuffer.mapped, m_globals.data(), sizeof(Globals));
 }
 
 void Renderer::createPipelines() {

@@ -63,8 +63,22 @@ class Renderer {
   const SceneSummary& summary() const { return m_summary; }
   const RenderSettings& settings() const { return m_settings; }
 
+  // ---- Progressive use (the preview window) ----
+  // Restart accumulation: the film is cleared and the sample index goes back to 0.
+  void reset();
+  // Move the camera; restarts accumulation.
+  void setCamera(const Camera& camera);
+  const Camera& camera() const { return m_cameraState; }
+  // Extra stages (e.g. the preview's display stage) run with the renderer's pipeline layout and
+  // descriptor set, so they see the same Globals; Globals.display is theirs to point at a buffer.
+  vk::Context& context() { return m_ctx; }
+  VkPipelineLayout pipelineLayout() const { return m_pipelineLayout; }
+  VkDescriptorSet descriptorSet() const { return m_set; }
+  void setDisplayBuffer(VkDeviceAddress address);
+
  private:
   void uploadScene(const Scene& scene);
+  void writeCamera(const Camera& camera);
   void createPipelines();
   void recordPass(VkCommandBuffer cmd, std::uint32_t chunkStart, std::uint32_t chunkCount);
   void dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst, std::uint32_t zeroCount,
@@ -76,6 +90,7 @@ class Renderer {
   std::uint32_t m_samples = 0;
   std::uint32_t m_capacity = 0;
   RenderStats m_totals;
+  Camera m_cameraState;
   std::vector<std::uint32_t> m_slotModels;  // model id of each shade slot
 
   // Host copy of the globals, rewritten before each chunk.
