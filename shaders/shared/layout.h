@@ -5,6 +5,7 @@
 #define NUSSELT_LAYOUT_H
 
 #include "prelude.h"
+#include "quadtree_layout.h"
 
 SHARED_BEGIN
 
@@ -96,7 +97,7 @@ struct BrdfParams {
 };
 STATIC_ASSERT_SIZE(BrdfParams, 128);
 
-// info = (model id, MATERIAL_* flags, table offset for models that need one, 0).
+// info = (model id, MATERIAL_* flags, quadtree set index (QuadSet) or INVALID_INDEX, shade slot).
 // emission = emitted radiance (rgb), w unused.
 struct GpuMaterial {
   uvec4 info;
@@ -138,6 +139,10 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer Vec4s { vec
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer UVec4s { uvec4 v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer Floats { float v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer Uints { uint v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer QuadSets { QuadSet v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer QuadTables { QuadTable v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer QuadNodes { QuadNode v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer QuadLeaves { QuadLeaf v[]; };
 #endif
 
 // Per-render constants and the addresses of every buffer (buffer device addresses: no storage
@@ -174,10 +179,13 @@ struct Globals {
   BUFREF(Uints) queues;        // QUEUE_HEADER_UINTS counters, then QUEUE_COUNT item arrays
   BUFREF(UVec4s) dispatchArgs; // QUEUE_COUNT DispatchArgs
   BUFREF(Uints) stats;         // STAT_COUNT counters
-  BUFREF(Floats) tables;       // model tables (albedo tables, quadtrees) addressed by offsets
+  BUFREF(QuadSets) quadSets;   // generic sampler: one set of trees per material (GpuMaterial.info.z)
+  BUFREF(QuadTables) quadTables;
+  BUFREF(QuadNodes) quadNodes;
+  BUFREF(QuadLeaves) quadLeaves;
   BUFREF(Uints) display;       // the preview's RGBA8 display buffer (0 when headless)
 };
-STATIC_ASSERT_SIZE(Globals, 48 + 7 * 16 + 22 * 8);
+STATIC_ASSERT_SIZE(Globals, 48 + 7 * 16 + 25 * 8);
 
 // Push constants of every stage.
 struct StageConstants {

@@ -330,6 +330,10 @@ int runCli(int argc, char** argv) {
   diff->add_option("image", diffA, "Image")->required();
   diff->add_option("reference", diffB, "Reference image")->required();
 
+  CommandRunner run;
+  registerSamplerCommands(app, *bench, run);
+  registerPreviewCommand(app, run);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -337,6 +341,7 @@ int runCli(int argc, char** argv) {
     return code == 0 ? kExitOk : kExitUsage;
   }
   try {
+    if (run) return run();
     if (*render) return renderCommand(ra);
     if (*devices) return devicesCommand();
     if (*benchRender) return benchRenderCommand(ba);

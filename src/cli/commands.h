@@ -1,5 +1,22 @@
 // commands.h: the command line of nusselt (`nusselt --help`). Returns the process exit status.
 #pragma once
-namespace nusselt {
-int runCli(int argc, char** argv);
+#include <functional>
+
+namespace CLI {
+class App;
 }
+
+namespace nusselt {
+
+int runCli(int argc, char** argv);
+
+// Modules add their own subcommands. A subcommand's CLI11 callback stores in `run` the work to
+// do; runCli calls it after parsing, inside the error handling every command shares (a
+// nusselt::Error becomes "error: ..." and exit status 1).
+using CommandRunner = std::function<int()>;
+// `nusselt sample` and `nusselt bench precompute` (src/cli/sampler_commands.cpp).
+void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run);
+// `nusselt preview` (src/render/preview.cpp).
+void registerPreviewCommand(CLI::App& app, CommandRunner& run);
+
+}  // namespace nusselt

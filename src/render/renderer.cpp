@@ -110,7 +110,7 @@ void Renderer::uploadScene(const Scene& scene) {
     if (luminance(src.emission) > 0.0f || src.emission.x > 0 || src.emission.y > 0 || src.emission.z > 0)
       flags |= MATERIAL_EMISSIVE;
     if (modelById(src.model).delta) flags |= MATERIAL_DELTA;
-    dst.info = glm::uvec4(src.model, flags, 0u, slot);
+    dst.info = glm::uvec4(src.model, flags, INVALID_INDEX, slot);
     dst.emission = v4(src.emission);
     dst.params = src.params;
   }
@@ -237,8 +237,11 @@ void Renderer::uploadScene(const Scene& scene) {
   m_stats = make(STAT_COUNT * 4, "statistics", nullptr, 0, true);
   std::memset(m_stats->mapped, 0, STAT_COUNT * 4);
   g.stats = m_stats->address;
-  float zero = 0.0f;
-  g.tables = make(4, "tables", &zero)->address;
+  // Generic-sampler tables: none yet (every model is cosine sampled until the quadtrees land).
+  g.quadSets = make(sizeof(shared::QuadSet), "quadtree sets")->address;
+  g.quadTables = make(sizeof(shared::QuadTable), "quadtree tables")->address;
+  g.quadNodes = make(sizeof(shared::QuadNode), "quadtree nodes")->address;
+  g.quadLeaves = make(sizeof(shared::QuadLeaf), "quadtree leaves")->address;
   g.display = 0;
 
   // Film starts at zero.
