@@ -67,12 +67,14 @@ void printSceneWarnings(const Scene& scene, bool quiet) {
 
 struct RenderArgs {
   std::string scene;
-  std::string output = "render.exr";
+  std::string output;
   std::string png;
   std::string camera;
+  std::string resume;
   std::uint32_t spp = 64;
   std::uint32_t width = 0, height = 0;
   std::uint32_t seed = 0;
+  std::uint32_t sppOffset = 0;
   std::uint32_t maxDepth = 8;
   int device = -1;
   std::string lighting = "mis";
@@ -82,10 +84,102 @@ struct RenderArgs {
   float exposure = 0.0f;
 };
 
+// What a render records in its EXR header (and what --resume and merge check and carry on).
+struct RenderRecord {
+  std::string scene;
+  std::string device;
+  std::string models;
+  RenderSettings settings;
+  std::uint32_t spp = 0;
+  bool interrupted = false;
+  RenderStats stats;
+  std::uint64_t droppedTriangles = 0;
+  double renderSeconds = 0;
+  double totalSeconds = 0;
+};
+
+LightingMode parseLighting(const std::string& name) {
+  return name == "nee" ? LightingMode::NeeOnly : name == "bsdf" ? LightingMode::BsdfOnly : LightingMode::Mis;
+}
+
+ImageMetadata makeMetadata(const RenderRecord& r) {
+  ImageMetadata meta;
+  meta.strings = {{"nusselt/version", NUSSELT_VERSION},
+                  {"nusselt/scene", r.scene},
+                  {"nusselt/device", r.device},
+                  {"nusselt/integrator", "wavefront path tracer: NEE + BSDF sampling, MIS power heuristic, "
+                                         "albedo Russian roulette"},
+                  {"nusselt/lighting", lightingModeName(r.settings.lighting)},
+                  {"nusselt/sampler", "cosine"},
+                  {"nusselt/models", r.models}};
+  meta.ints = {{"nusselt/spp", r.spp},
+               {"nusselt/sppOffset", r.settings.sampleOffset},
+               {"nusselt/seed", r.settings.seed},
+               {"nusselt/maxDepth", r.settings.maxDepth},
+               {"nusselt/interrupted", r.interrupted ? 1 : 0},
+               {"nusselt/rays", static_cast<std::int64_t>(r.stats.rays)},
+               {"nusselt/shadowRays", static_cast<std::int64_t>(r.stats.shadowRays)},
+               {"nusselt/nonFiniteSamples", static_cast<std::int64_t>(r.stats.nonFiniteSamples)},
+               {"nusselt/bvhStackOverflows", static_cast<std::int64_t>(r.stats.bvhStackOverflows)},
+               {"nusselt/samplerBoundViolations", static_cast<std::int64_t>(r.stats.samplerBoundViolations)},
+               {"nusselt/samplerTrialFailures", static_cast<std::int64_t>(r.stats.samplerTrialFailures)},
+               {"nusselt/droppedTriangles", static_cast<std::int64_t>(r.droppedTriangles)}};
+  meta.doubles = {{"nusselt/renderSeconds", r.renderSeconds}, {"nusselt/totalSeconds", r.totalSeconds}};
+  return meta;
+}
+
+// Reads back what makeMetadata wrote; throws naming the file and the attribute when one is missing.
+RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
+  auto str = [&](const char* name) {
+    auto v = findString(meta, name);
+    if (!v) throw Error(path + ": header attribute " + name + " is missing (not written by nusselt?)");
+    return *v;
+  };
+  auto num = [&](const char* name) {
+    auto v = findInt(meta, name);
+    if (!v || *v < 0) throw Error(path + ": header attribute " + name + " is missing or negative");
+    return *v;
+  };
+  RenderRecord r;
+  r.scene = str("nusselt/scene");
+  r.device = str("nusselt/device");
+  r.models = str("nusselt/models");
+  std::string lighting = str("nusselt/lighting");
+  r.settings.lighting = parseLighting(lighting);
+  r.spp = static_cast<std::uint32_t>(num("nusselt/spp"));
+  r.settings.sampleOffset = static_cast<std::uint32_t>(num("nusselt/sppOffset"));
+  r.settings.seed = static_cast<std::uint32_t>(num("nusselt/seed"));
+  r.settings.maxDepth = static_cast<std::uint32_t>(num("nusselt/maxDepth"));
+  r.stats.rays = num("nusselt/rays");
+  r.stats.shadowRays = num("nusselt/shadowRays");
+  r.stats.nonFiniteSamples = num("nusselt/nonFiniteSamples");
+  r.stats.bvhStackOverflows = num("nusselt/bvhStackOverflows");
+  r.stats.samplerBoundViolations = num("nusselt/samplerBoundViolations");
+  r.stats.samplerTrialFailures = num("nusselt/samplerTrialFailures");
+  r.droppedTriangles = num("nusselt/droppedTriangles");
+  r.renderSeconds = findDouble(meta, "nusselt/renderSeconds").value_or(0);
+  r.totalSeconds = findDouble(meta, "nusselt/totalSeconds").value_or(0);
+  return r;
+}
+
 int renderCommand(const RenderArgs& a) {
   if (a.spp == 0) throw Error("--spp 0: at least one sample per pixel is needed");
-  checkOutputPath(a.output, "-o");
+  const std::string output = !a.output.empty() ? a.output : !a.resume.empty() ? a.resume : "render.exr";
+  checkOutputPath(output, "-o");
   if (!a.png.empty()) checkOutputPath(a.png, "--png");
+
+  // A signal from here on is handled: before the first pass it just ends without output.
+  g_stopSignal = 0;
+  auto oldInt = std::signal(SIGINT, onSignal);
+  auto oldTerm = std::signal(SIGTERM, onSignal);
+  struct RestoreSignals {
+    void (*i)(int);
+    void (*t)(int);
+    ~RestoreSignals() {
+      std::signal(SIGINT, i);
+      std::signal(SIGTERM, t);
+    }
+  } restore{oldInt, oldTerm};
 
   Scene scene = loadSceneOrDefault(a.scene, a.camera);
   printSceneWarnings(scene, a.quiet);
@@ -94,11 +188,38 @@ int renderCommand(const RenderArgs& a) {
   s.spp = a.spp;
   s.seed = a.seed;
   s.maxDepth = a.maxDepth;
-  s.lighting = a.lighting == "nee" ? LightingMode::NeeOnly : a.lighting == "bsdf" ? LightingMode::BsdfOnly : LightingMode::Mis;
+  s.sampleOffset = a.sppOffset;
+  s.lighting = parseLighting(a.lighting);
   // Image size: defaults follow the camera's aspect ratio when only one side (or none) is given.
   float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
   s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u);
   s.height = a.height ? a.height : std::max(1u, unsigned(s.width / aspect + 0.5f));
+
+  // --resume: the saved render must be of this very render (scene and settings), fewer spp.
+  Image saved;
+  RenderRecord previous;
+  if (!a.resume.empty()) {
+    ImageMetadata meta;
+    saved = readExr(a.resume, &meta);
+    previous = readRecord(a.resume, meta);
+    auto mismatch = [&](const std::string& what, const std::string& was, const std::string& now) {
+      if (was != now)
+        throw Error("--resume " + a.resume + ": " + what + " was " + was + ", this render has " + now +
+                    " (a render can only be resumed with the same scene and settings)");
+    };
+    mismatch("the scene", previous.scene, scene.sourcePath);
+    mismatch("the image size", std::to_string(saved.width) + "x" + std::to_string(saved.height),
+             std::to_string(s.width) + "x" + std::to_string(s.height));
+    mismatch("--seed", std::to_string(previous.settings.seed), std::to_string(s.seed));
+    mismatch("--max-depth", std::to_string(previous.settings.maxDepth), std::to_string(s.maxDepth));
+    mismatch("--lighting", lightingModeName(previous.settings.lighting), lightingModeName(s.lighting));
+    mismatch("--spp-offset", std::to_string(previous.settings.sampleOffset), std::to_string(s.sampleOffset));
+    if (saved.sum.empty() || saved.sumSq.empty())
+      throw Error("--resume " + a.resume + ": no accumulation channels (sum.R/G/B, sumSq.R/G/B)");
+    if (previous.spp >= s.spp)
+      throw Error("--resume " + a.resume + ": it already has " + std::to_string(previous.spp) +
+                  " spp; ask for more with --spp (the total)");
+  }
 
   vk::Context ctx;
   vk::ContextOptions co;
@@ -110,79 +231,74 @@ int renderCommand(const RenderArgs& a) {
     auto t0 = std::chrono::steady_clock::now();
     Renderer renderer(ctx, scene, s);
     const SceneSummary& sum = renderer.summary();
+    std::string models;
+    for (auto& m : sum.models) models += (models.empty() ? "" : ",") + m;
+    if (!a.resume.empty()) {
+      if (previous.device != ctx.deviceName && !a.quiet)
+        std::fprintf(stderr, "warning: %s was rendered on %s; continuing on %s (not bit-identical to an uninterrupted render)\n",
+                     a.resume.c_str(), previous.device.c_str(), ctx.deviceName.c_str());
+      renderer.restoreAccumulation(saved, previous.spp);
+      renderer.addStats(previous.stats);
+    }
     if (!a.quiet) {
-      std::string models;
-      for (auto& m : sum.models) models += (models.empty() ? "" : ",") + m;
       std::fprintf(stderr, "scene: %s: %zu triangles, %zu materials (models: %s), %zu lights; BVH %u nodes in %.3f s\n",
                    scene.sourcePath.c_str(), sum.triangles, sum.materials, models.c_str(), sum.lights, sum.bvhNodes,
                    sum.bvhSeconds);
-      std::fprintf(stderr, "device: %s; %ux%u, %u spp, max depth %u, seed %u, lighting %s\n", ctx.deviceName.c_str(),
-                   s.width, s.height, s.spp, s.maxDepth, s.seed, lightingModeName(s.lighting));
+      std::fprintf(stderr, "device: %s; %ux%u, %u spp%s, max depth %u, seed %u, lighting %s\n", ctx.deviceName.c_str(),
+                   s.width, s.height, s.spp,
+                   a.resume.empty() ? "" : (" (resuming from " + std::to_string(previous.spp) + ")").c_str(),
+                   s.maxDepth, s.seed, lightingModeName(s.lighting));
     }
 
-    g_stopSignal = 0;
-    auto oldInt = std::signal(SIGINT, onSignal);
-    auto oldTerm = std::signal(SIGTERM, onSignal);
     auto tRender = std::chrono::steady_clock::now();
     {
       Progress progress("render", s.spp, std::uint64_t(s.width) * s.height, false, a.quiet);
+      progress.update(renderer.samplesDone());
       while (renderer.samplesDone() < s.spp && g_stopSignal == 0) {
         renderer.renderPass();
         progress.update(renderer.samplesDone());
       }
+      double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - tRender).count();
       RenderStats st = renderer.stats();
       char extra[256];
-      std::snprintf(extra, sizeof extra, "%.2f Mrays/s", (st.rays + st.shadowRays) / 1e6 /
-                                                              std::max(1e-9, std::chrono::duration<double>(std::chrono::steady_clock::now() - tRender).count()));
+      std::snprintf(extra, sizeof extra, "%.2f Mrays/s",
+                    (st.rays + st.shadowRays - previous.stats.rays - previous.stats.shadowRays) / 1e6 / std::max(1e-9, sec));
       progress.finish(extra);
     }
-    std::signal(SIGINT, oldInt);
-    std::signal(SIGTERM, oldTerm);
-    double renderSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tRender).count();
-    double totalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    RenderStats st = renderer.stats();
-    const bool interrupted = g_stopSignal != 0;
-    if (interrupted)
+    RenderRecord rec;
+    rec.scene = scene.sourcePath;
+    rec.device = ctx.deviceName;
+    rec.models = models;
+    rec.settings = s;
+    rec.spp = renderer.samplesDone();
+    rec.interrupted = g_stopSignal != 0;
+    rec.stats = renderer.stats();
+    rec.droppedTriangles = scene.droppedTriangles;
+    rec.renderSeconds = previous.renderSeconds +
+                        std::chrono::duration<double>(std::chrono::steady_clock::now() - tRender).count();
+    rec.totalSeconds = previous.totalSeconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (rec.interrupted)
       std::fprintf(stderr, "interrupted by %s after %u of %u spp: writing what has accumulated\n",
-                   g_stopSignal == SIGINT ? "SIGINT" : "SIGTERM", renderer.samplesDone(), s.spp);
+                   g_stopSignal == SIGINT ? "SIGINT" : "SIGTERM", rec.spp, s.spp);
 
-    if (renderer.samplesDone() > 0) {
+    if (rec.spp > previous.spp) {
       Image img = renderer.image(a.variance);
-      ImageMetadata meta;
-      meta.strings = {{"nusselt/version", NUSSELT_VERSION},
-                      {"nusselt/scene", scene.sourcePath},
-                      {"nusselt/device", ctx.deviceName},
-                      {"nusselt/integrator", "wavefront path tracer: NEE + BSDF sampling, MIS power heuristic, "
-                                             "albedo Russian roulette"},
-                      {"nusselt/lighting", lightingModeName(s.lighting)},
-                      {"nusselt/sampler", "cosine"},
-                      {"nusselt/models", [&] { std::string m; for (auto& x : renderer.summary().models) m += (m.empty() ? "" : ",") + x; return m; }()}};
-      meta.ints = {{"nusselt/spp", renderer.samplesDone()},
-                   {"nusselt/sppRequested", s.spp},
-                   {"nusselt/seed", s.seed},
-                   {"nusselt/maxDepth", s.maxDepth},
-                   {"nusselt/interrupted", interrupted ? 1 : 0},
-                   {"nusselt/nonFiniteSamples", static_cast<std::int64_t>(st.nonFiniteSamples)},
-                   {"nusselt/samplerBoundViolations", static_cast<std::int64_t>(st.samplerBoundViolations)},
-                   {"nusselt/samplerTrialFailures", static_cast<std::int64_t>(st.samplerTrialFailures)},
-                   {"nusselt/droppedTriangles", static_cast<std::int64_t>(scene.droppedTriangles)}};
-      meta.doubles = {{"nusselt/renderSeconds", renderSeconds}, {"nusselt/totalSeconds", totalSeconds}};
-      writeExr(a.output, img, meta);
+      writeExr(output, img, makeMetadata(rec));
       if (!a.png.empty()) writePng(a.png, img, a.exposure);
       if (!a.quiet) {
-        std::fprintf(stderr, "wrote %s (%u spp)%s%s\n", a.output.c_str(), renderer.samplesDone(),
-                     a.png.empty() ? "" : " and ", a.png.c_str());
-        if (st.nonFiniteSamples)
+        std::fprintf(stderr, "wrote %s (%u spp)%s%s\n", output.c_str(), rec.spp, a.png.empty() ? "" : " and ",
+                     a.png.c_str());
+        if (rec.stats.nonFiniteSamples)
           std::fprintf(stderr, "warning: %llu non-finite samples were dropped\n",
-                       static_cast<unsigned long long>(st.nonFiniteSamples));
-        if (st.bvhStackOverflows)
+                       static_cast<unsigned long long>(rec.stats.nonFiniteSamples));
+        if (rec.stats.bvhStackOverflows)
           std::fprintf(stderr, "warning: %llu BVH traversals overflowed their stack\n",
-                       static_cast<unsigned long long>(st.bvhStackOverflows));
+                       static_cast<unsigned long long>(rec.stats.bvhStackOverflows));
       }
     } else {
       std::fprintf(stderr, "no sample was completed: nothing written\n");
     }
-    if (interrupted) status = kExitInterrupted;
+    if (rec.interrupted) status = kExitInterrupted;
   }
   std::uint64_t messages = ctx.validationMessages.load();
   vk::destroyContext(ctx);
@@ -191,6 +307,72 @@ int renderCommand(const RenderArgs& a) {
     if (status == kExitOk) status = kExitFailure;
   }
   return status;
+}
+
+// Combines partial renders of disjoint sample ranges (--spp-offset) into one, weighted by spp:
+// the sums add. Equals a single render of the same samples up to float rounding of the sums.
+int mergeCommand(const std::vector<std::string>& inputs, const std::string& output) {
+  if (inputs.size() < 2) throw Error("merge: give at least two images");
+  checkOutputPath(output, "-o");
+  Image total;
+  RenderRecord merged;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+  for (std::size_t k = 0; k < inputs.size(); ++k) {
+    ImageMetadata meta;
+    Image img = readExr(inputs[k], &meta);
+    RenderRecord r = readRecord(inputs[k], meta);
+    if (img.sum.empty() || img.sumSq.empty())
+      throw Error(inputs[k] + ": no accumulation channels (sum.R/G/B, sumSq.R/G/B): not a nusselt render");
+    if (k == 0) {
+      total = img;
+      merged = r;
+      merged.spp = 0;
+      merged.stats = RenderStats{};
+      merged.renderSeconds = merged.totalSeconds = 0;
+    } else {
+      auto same = [&](const std::string& what, const std::string& a, const std::string& b) {
+        if (a != b) throw Error(inputs[k] + ": " + what + " is " + b + " but " + inputs[0] + " has " + a);
+      };
+      same("the image size", std::to_string(total.width) + "x" + std::to_string(total.height),
+           std::to_string(img.width) + "x" + std::to_string(img.height));
+      same("the scene", merged.scene, r.scene);
+      same("the seed", std::to_string(merged.settings.seed), std::to_string(r.settings.seed));
+      same("the max depth", std::to_string(merged.settings.maxDepth), std::to_string(r.settings.maxDepth));
+      same("the lighting", lightingModeName(merged.settings.lighting), lightingModeName(r.settings.lighting));
+      for (std::size_t i = 0; i < total.sum.size(); ++i) {
+        total.sum[i] += img.sum[i];
+        total.sumSq[i] += img.sumSq[i];
+      }
+    }
+    for (auto [lo, n] : ranges)
+      if (r.settings.sampleOffset < lo + n && lo < r.settings.sampleOffset + r.spp)
+        throw Error(inputs[k] + ": its samples [" + std::to_string(r.settings.sampleOffset) + ", " +
+                    std::to_string(r.settings.sampleOffset + r.spp) + ") overlap another input's [" +
+                    std::to_string(lo) + ", " + std::to_string(lo + n) + "): partial renders need distinct --spp-offset ranges");
+    ranges.push_back({r.settings.sampleOffset, r.spp});
+    merged.spp += r.spp;
+    merged.settings.sampleOffset = std::min(merged.settings.sampleOffset, r.settings.sampleOffset);
+    merged.interrupted = merged.interrupted || r.interrupted;
+    merged.stats.rays += r.stats.rays;
+    merged.stats.shadowRays += r.stats.shadowRays;
+    merged.stats.nonFiniteSamples += r.stats.nonFiniteSamples;
+    merged.stats.bvhStackOverflows += r.stats.bvhStackOverflows;
+    merged.stats.samplerBoundViolations += r.stats.samplerBoundViolations;
+    merged.stats.samplerTrialFailures += r.stats.samplerTrialFailures;
+    merged.renderSeconds += r.renderSeconds;
+    merged.totalSeconds += r.totalSeconds;
+  }
+  const float n = float(merged.spp);
+  total.variance.assign(total.sum.size(), 0.0f);
+  for (std::size_t i = 0; i < total.sum.size(); ++i) {
+    float mean = total.sum[i] / n;
+    total.rgb[i] = mean;
+    double var = n > 1 ? (double(total.sumSq[i]) - double(n) * mean * mean) / (double(n) - 1.0) : 0.0;
+    total.variance[i] = static_cast<float>(std::max(var, 0.0) / n);
+  }
+  writeExr(output, total, makeMetadata(merged));
+  std::fprintf(stderr, "merged %zu renders into %s (%u spp)\n", inputs.size(), output.c_str(), merged.spp);
+  return kExitOk;
 }
 
 int devicesCommand() {
@@ -288,7 +470,7 @@ int runCli(int argc, char** argv) {
   RenderArgs ra;
   CLI::App* render = app.add_subcommand("render", "Render a glTF scene (default: the built-in Cornell box) to OpenEXR");
   render->add_option("scene", ra.scene, "glTF 2.0 scene (.gltf or .glb); omitted: the built-in Cornell box");
-  render->add_option("-o,--output", ra.output, "Output OpenEXR file (32-bit float RGB)")->capture_default_str();
+  render->add_option("-o,--output", ra.output, "Output OpenEXR file (32-bit float RGB; default render.exr, or the --resume file)");
   render->add_option("--spp", ra.spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(0u, 1u << 30));
   render->add_option("--width", ra.width, "Image width in pixels (default 512, or from --height and the camera's aspect ratio)")
       ->check(CLI::Range(1u, 65536u));
@@ -305,6 +487,11 @@ int runCli(int argc, char** argv) {
   render->add_option("--lighting", ra.lighting, "Light transport estimator: mis (NEE + BSDF sampling, power heuristic), "
                                                 "nee (light sampling only), bsdf (BSDF sampling only)")
       ->capture_default_str()->check(CLI::IsMember({"mis", "nee", "bsdf"}));
+  render->add_option("--resume", ra.resume, "Continue the render saved in this EXR up to --spp samples in all "
+                                            "(same scene and settings; written back to it unless -o is given)");
+  render->add_option("--spp-offset", ra.sppOffset, "First sample index of this render: split a frame across machines "
+                                                   "into disjoint ranges and combine them with `nusselt merge`")
+      ->capture_default_str();
   render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
   render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
   render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");
@@ -321,6 +508,12 @@ int runCli(int argc, char** argv) {
   benchRender->add_option("--width", ba.width, "Image width")->capture_default_str()->check(CLI::Range(1u, 65536u));
   benchRender->add_option("--height", ba.height, "Image height")->capture_default_str()->check(CLI::Range(1u, 65536u));
   benchRender->add_option("--device", ba.device, "Vulkan device index");
+
+  std::vector<std::string> mergeInputs;
+  std::string mergeOutput;
+  CLI::App* merge = app.add_subcommand("merge", "Combine partial renders of disjoint sample ranges (--spp-offset) into one");
+  merge->add_option("inputs", mergeInputs, "Partial renders (EXR written by nusselt render)")->required();
+  merge->add_option("-o,--output", mergeOutput, "Merged image")->required();
 
   std::vector<std::string> infoFiles;
   CLI::App* info = app.add_subcommand("info", "Print the size, mean and header attributes of OpenEXR images");
@@ -346,6 +539,7 @@ int runCli(int argc, char** argv) {
     if (*devices) return devicesCommand();
     if (*benchRender) return benchRenderCommand(ba);
     if (*info) return infoCommand(infoFiles);
+    if (*merge) return mergeCommand(mergeInputs, mergeOutput);
     if (*diff) return diffCommand(diffA, diffB);
   } catch (const Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

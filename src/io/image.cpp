@@ -16,6 +16,8 @@
 
 #include <Iex.h>
 #include <ImfChannelList.h>
+#include <array>
+#include <type_traits>
 #include <ImfDoubleAttribute.h>
 #include <ImfFloatAttribute.h>
 #include <ImfFrameBuffer.h>
@@ -44,6 +46,15 @@
 namespace nusselt {
 namespace {
 
+// The optional three-channel groups of an Image, by channel-name prefix.
+template <class ImageT>
+auto optionalGroups(ImageT& image) {
+  using Vec = std::conditional_t<std::is_const_v<ImageT>, const std::vector<float>, std::vector<float>>;
+  return std::array<std::pair<const char*, Vec*>, 3>{
+      {{"var", &image.variance}, {"sum", &image.sum}, {"sumSq", &image.sumSq}}};
+}
+
+
 Error writeError(const std::string& path, const std::string& reason) {
   return Error("cannot write '" + path + "': " + reason);
 }
@@ -68,10 +79,10 @@ void checkImage(const std::string& path, const Image& image) {
                                std::to_string(image.height) + " but has " +
                                std::to_string(image.rgb.size()) + " RGB values (expected " +
                                std::to_string(expected) + ")");
-  if (!image.variance.empty() && image.variance.size() != expected)
-    throw writeError(path, "image has " + std::to_string(image.variance.size()) +
-                               " variance values (expected 0 or " + std::to_string(expected) +
-                               ")");
+  for (auto& [prefix, values] : optionalGroups(image))
+    if (!values->empty() && values->size() != expected)
+      throw writeError(path, "image has " + std::to_string(values->size()) + " " + prefix +
+                                 " values (expected 0 or " + std::to_string(expected) + ")");
 }
 
 // Writes all n bytes, retrying on EINTR and short writes. Returns 0 or an errno value.
@@ -229,9 +240,9 @@ Imf::Header makeHeader(const std::string& path, const Image& image, const ImageM
   header.lineOrder() = Imf::INCREASING_Y;
   Imf::ChannelList& channels = header.channels();
   for (const char* name : {"R", "G", "B"}) channels.insert(name, Imf::Channel(Imf::FLOAT));
-  if (!image.variance.empty())
-    for (const char* name : {"var.R", "var.G", "var.B"})
-      channels.insert(name, Imf::Channel(Imf::FLOAT));
+  for (auto& [prefix, values] : optionalGroups(image))
+    if (!values->empty())
+      for (const char* c : {".R", ".G", ".B"}) channels.insert(std::string(prefix) + c, Imf::Channel(Imf::FLOAT));
 
   std::set<std::string> seen;
   auto checkName = [&](const std::string& name) {
@@ -319,12 +330,13 @@ void writeExr(const std::string& path, const Image& image, const ImageMetadata& 
       frame.insert("R", interleavedSlice(rgb + 0, window, image.width));
       frame.insert("G", interleavedSlice(rgb + 1, window, image.width));
       frame.insert("B", interleavedSlice(rgb + 2, window, image.width));
-      if (!image.variance.empty()) {
-        const float* var = image.variance.data();
-        frame.insert("var.R", interleavedSlice(var + 0, window, image.width));
-        frame.insert("var.G", interleavedSlice(var + 1, window, image.width));
-        frame.insert("var.B", interleavedSlice(var + 2, window, image.width));
-      }
+      for (auto& [prefix, values] : optionalGroups(image))
+        if (!values->empty()) {
+          const float* v = values->data();
+          frame.insert(std::string(prefix) + ".R", interleavedSlice(v + 0, window, image.width));
+          frame.insert(std::string(prefix) + ".G", interleavedSlice(v + 1, window, image.width));
+          frame.insert(std::string(prefix) + ".B", interleavedSlice(v + 2, window, image.width));
+        }
       Imf::OutputFile file(stream, header);
       file.setFrameBuffer(frame);
       file.writePixels(image.height);
@@ -369,7 +381,9 @@ Image readExr(const std::string& path, ImageMetadata* meta) {
     };
     for (const char* name : {"R", "G", "B"})
       if (!usable(name)) throw readError(path, std::string("no ") + name + " channel");
-    bool hasVariance = usable("var.R") && usable("var.G") && usable("var.B");
+    auto hasGroup = [&](const std::string& prefix) {
+      return usable((prefix + ".R").c_str()) && usable((prefix + ".G").c_str()) && usable((prefix + ".B").c_str());
+    };
 
     // A file cut short (crash, full disk of whoever wrote it) would otherwise read as an image
     // with missing rows silently zeroed, or fail later with a less clear message.
@@ -378,19 +392,21 @@ Image readExr(const std::string& path, ImageMetadata* meta) {
     image.width = int(width);
     image.height = int(height);
     image.rgb.assign(size_t(3) * size_t(width) * size_t(height), 0.0f);
-    if (hasVariance) image.variance.assign(image.rgb.size(), 0.0f);
+    for (auto& [prefix, values] : optionalGroups(image))
+      if (hasGroup(prefix)) values->assign(image.rgb.size(), 0.0f);
 
     Imf::FrameBuffer frame;
     float* rgb = image.rgb.data();
     frame.insert("R", interleavedSlice(rgb + 0, window, image.width));
     frame.insert("G", interleavedSlice(rgb + 1, window, image.width));
     frame.insert("B", interleavedSlice(rgb + 2, window, image.width));
-    if (hasVariance) {
-      float* var = image.variance.data();
-      frame.insert("var.R", interleavedSlice(var + 0, window, image.width));
-      frame.insert("var.G", interleavedSlice(var + 1, window, image.width));
-      frame.insert("var.B", interleavedSlice(var + 2, window, image.width));
-    }
+    for (auto& [prefix, values] : optionalGroups(image))
+      if (!values->empty()) {
+        float* v = values->data();
+        frame.insert(std::string(prefix) + ".R", interleavedSlice(v + 0, window, image.width));
+        frame.insert(std::string(prefix) + ".G", interleavedSlice(v + 1, window, image.width));
+        frame.insert(std::string(prefix) + ".B", interleavedSlice(v + 2, window, image.width));
+      }
     file.setFrameBuffer(frame);
     file.readPixels(window.min.y, window.max.y);
 

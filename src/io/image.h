@@ -19,6 +19,11 @@ struct Image {
   // Optional per-pixel variance of the mean (3 floats/pixel), written as the channels
   // var.R var.G var.B when non-empty. Empty, or exactly the size of rgb.
   std::vector<float> variance;
+  // Optional raw accumulation, for resuming and merging renders (3 floats/pixel each): the sum
+  // of the samples (channels sum.R/G/B) and of their squares (sumSq.R/G/B). Present in every
+  // render nusselt writes, so that `--resume` and `nusselt merge` continue bit-exactly.
+  std::vector<float> sum;
+  std::vector<float> sumSq;
 };
 
 // Header attributes of an EXR. Names are free-form (e.g. "nusselt/spp") and kept exactly; they

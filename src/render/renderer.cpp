@@ -415,7 +415,7 @@ void Renderer::renderPass() {
     Globals* g = reinterpret_cast<Globals*>(m_globals.data());
     g->image.z = static_cast<std::uint32_t>(start);
     g->image.w = count;
-    g->frame.x = m_samples;
+    g->frame.x = m_settings.sampleOffset + m_samples;
     std::memcpy(m_globalsBuffer.mapped, m_globals.data(), sizeof(Globals));
 
     VK_CHECK(vkResetCommandBuffer(m_cmd, 0));
@@ -445,20 +445,21 @@ void Renderer::renderPass() {
 
 Image Renderer::image(bool withVariance) {
   const std::uint64_t pixels = std::uint64_t(m_settings.width) * m_settings.height;
-  std::vector<glm::vec4> sum(pixels), sumSq;
+  std::vector<glm::vec4> sum(pixels), sumSq(pixels);
   vk::downloadBuffer(m_ctx, *m_film, sum.data(), pixels * 16);
-  if (withVariance) {
-    sumSq.resize(pixels);
-    vk::downloadBuffer(m_ctx, *m_filmSq, sumSq.data(), pixels * 16);
-  }
+  vk::downloadBuffer(m_ctx, *m_filmSq, sumSq.data(), pixels * 16);
   Image img;
   img.width = static_cast<int>(m_settings.width);
   img.height = static_cast<int>(m_settings.height);
   img.rgb.resize(pixels * 3);
   if (withVariance) img.variance.resize(pixels * 3);
+  img.sum.resize(pixels * 3);
+  img.sumSq.resize(pixels * 3);
   for (std::uint64_t i = 0; i < pixels; ++i) {
     float n = sum[i].w;
     for (int c = 0; c < 3; ++c) {
+      img.sum[3 * i + c] = sum[i][c];
+      img.sumSq[3 * i + c] = sumSq[i][c];
       float mean = n > 0 ? sum[i][c] / n : 0.0f;
       img.rgb[3 * i + c] = mean;
       if (withVariance) {
@@ -472,5 +473,31 @@ Image Renderer::image(bool withVariance) {
 }
 
 RenderStats Renderer::stats() const { return m_totals; }
+
+void Renderer::addStats(const RenderStats& c) {
+  m_totals.rays += c.rays;
+  m_totals.shadowRays += c.shadowRays;
+  m_totals.nonFiniteSamples += c.nonFiniteSamples;
+  m_totals.bvhStackOverflows += c.bvhStackOverflows;
+  m_totals.samplerBoundViolations += c.samplerBoundViolations;
+  m_totals.samplerTrialFailures += c.samplerTrialFailures;
+}
+
+void Renderer::restoreAccumulation(const Image& saved, std::uint32_t spp) {
+  const std::uint64_t pixels = std::uint64_t(m_settings.width) * m_settings.height;
+  if (saved.width != int(m_settings.width) || saved.height != int(m_settings.height))
+    throw Error("the saved image is " + std::to_string(saved.width) + "x" + std::to_string(saved.height) +
+                " but this render is " + std::to_string(m_settings.width) + "x" + std::to_string(m_settings.height));
+  if (saved.sum.size() != pixels * 3 || saved.sumSq.size() != pixels * 3)
+    throw Error("the saved image has no accumulation channels (sum.R/G/B, sumSq.R/G/B)");
+  std::vector<glm::vec4> sum(pixels), sumSq(pixels);
+  for (std::uint64_t i = 0; i < pixels; ++i) {
+    sum[i] = glm::vec4(saved.sum[3 * i], saved.sum[3 * i + 1], saved.sum[3 * i + 2], float(spp));
+    sumSq[i] = glm::vec4(saved.sumSq[3 * i], saved.sumSq[3 * i + 1], saved.sumSq[3 * i + 2], 0.0f);
+  }
+  vk::uploadBuffer(m_ctx, *m_film, sum.data(), pixels * 16);
+  vk::uploadBuffer(m_ctx, *m_filmSq, sumSq.data(), pixels * 16);
+  m_samples = spp;
+}
 
 }  // namespace nusselt

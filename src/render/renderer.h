@@ -23,6 +23,9 @@ struct RenderSettings {
   std::uint32_t maxDepth = 8;       // pbrt's convention: 0 = emitted light only, 1 = direct light
   std::uint32_t seed = 0;
   LightingMode lighting = LightingMode::Mis;
+  // Sample indices of this render start here (`--spp-offset`): a frame can be split across
+  // machines into disjoint sample ranges and merged (`nusselt merge`).
+  std::uint32_t sampleOffset = 0;
   // Paths traced together in one chunk of a pass (path state memory ~128 bytes each).
   std::uint32_t maxPathsPerChunk = 1u << 20;
 };
@@ -57,8 +60,15 @@ class Renderer {
   // Traces one more sample per pixel (sample index = samplesDone()).
   void renderPass();
   std::uint32_t samplesDone() const { return m_samples; }
-  // The current estimate: film sum / samples; variance of the mean when withVariance.
+  // The current estimate: film sum / samples; variance of the mean when withVariance. The raw
+  // sums (Image::sum, Image::sumSq) are always included, for resuming and merging.
   Image image(bool withVariance = false);
+  // Continue from a saved accumulation (Image::sum/sumSq of `spp` samples of this render's
+  // settings): the next pass traces sample index sampleOffset + spp, so a resumed render equals
+  // an uninterrupted one bit for bit. Throws nusselt::Error when the image does not fit.
+  void restoreAccumulation(const Image& saved, std::uint32_t spp);
+  // Adds counts carried over from a resumed render to the statistics.
+  void addStats(const RenderStats& carried);
   RenderStats stats() const;
   const SceneSummary& summary() const { return m_summary; }
   const RenderSettings& settings() const { return m_settings; }

@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# Renders that lose nothing: --resume continues bit-exactly; --spp-offset splits a frame and
+# `nusselt merge` combines the parts into the single render of the same samples.
+# Usage: resume_and_merge.sh NUSSELT SOURCE_DIR
+set -u
+nusselt=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL $*"; fails=$((fails + 1)); }
+common=(--width 24 --height 16 --seed 3 --max-depth 4 -q)
+maxdiff() { "$nusselt" diff "$1" "$2" | sed -n 's/.*max |diff| //p'; }
+
+"$nusselt" render "${common[@]}" --spp 6 -o "$work/full.exr" || fail "full render"
+
+# Resume: 2 spp, then on to 6: identical pixels to the uninterrupted 6-spp render.
+"$nusselt" render "${common[@]}" --spp 2 -o "$work/part.exr" || fail "partial render"
+"$nusselt" render "${common[@]}" --spp 6 --resume "$work/part.exr" || fail "resume"
+[ "$("$nusselt" info "$work/part.exr" | sed -n 's/^  nusselt\/spp: //p')" = 6 ] || fail "resumed spp"
+[ "$(maxdiff "$work/part.exr" "$work/full.exr")" = 0 ] && echo "ok   resumed 2 -> 6 spp equals 6 spp bit for bit" ||
+  fail "resumed render differs: $("$nusselt" diff "$work/part.exr" "$work/full.exr")"
+
+# Resuming with other settings is refused, and the file is left as it was.
+cp "$work/part.exr" "$work/keep.exr"
+if "$nusselt" render --width 24 --height 16 --seed 4 --max-depth 4 -q --spp 8 --resume "$work/part.exr" 2>"$work/err"; then
+  fail "resume with another seed was accepted"
+else
+  grep -q "seed" "$work/err" && cmp -s "$work/part.exr" "$work/keep.exr" && echo "ok   resume with another seed refused: $(cat "$work/err")" ||
+    fail "resume refusal: $(cat "$work/err")"
+fi
+
+# An interrupted render resumes to the same image as an uninterrupted one.
+"$nusselt" render "${common[@]}" --spp 1000000 -o "$work/int.exr" &
+pid=$!
+sleep 3
+kill -INT $pid
+wait $pid
+k=$("$nusselt" info "$work/int.exr" 2>/dev/null | sed -n 's/^  nusselt\/spp: //p')
+if [ -n "$k" ] && [ "$k" -ge 1 ]; then
+  total=$((k + 3))
+  "$nusselt" render "${common[@]}" --spp $total --resume "$work/int.exr" || fail "resume after SIGINT"
+  "$nusselt" render "${common[@]}" --spp $total -o "$work/straight.exr" || fail "straight render"
+  [ "$(maxdiff "$work/int.exr" "$work/straight.exr")" = 0 ] && echo "ok   interrupted at $k spp, resumed to $total: identical" ||
+    fail "interrupted+resumed differs: $("$nusselt" diff "$work/int.exr" "$work/straight.exr")"
+else
+  fail "interrupted render wrote no spp"
+fi
+
+# Split across two jobs by --spp-offset, merged: the single 6-spp render up to float rounding
+# of the sums (the parts add their sums in another order).
+"$nusselt" render "${common[@]}" --spp 3 --spp-offset 0 -o "$work/a.exr" || fail "job a"
+"$nusselt" render "${common[@]}" --spp 3 --spp-offset 3 -o "$work/b.exr" || fail "job b"
+"$nusselt" merge "$work/a.exr" "$work/b.exr" -o "$work/merged.exr" 2>/dev/null || fail "merge"
+d=$(maxdiff "$work/merged.exr" "$work/full.exr")
+mean=$("$nusselt" diff "$work/merged.exr" "$work/full.exr" | sed -n 's/.*mean \([^ ]*\) .*/\1/p')
+# Float rounding of a 6-term sum: a few ulps of the largest values (radiance up to ~20 here).
+awk -v d="$d" 'BEGIN { exit !(d <= 2e-5 * 20) }' && echo "ok   merged offsets 0+3 equal the 6-spp render (max |diff| $d)" ||
+  fail "merged image differs: max |diff| $d"
+[ "$("$nusselt" info "$work/merged.exr" | sed -n 's/^  nusselt\/spp: //p')" = 6 ] || fail "merged spp"
+
+# Overlapping sample ranges are refused.
+if "$nusselt" merge "$work/a.exr" "$work/a.exr" -o "$work/bad.exr" 2>"$work/err"; then
+  fail "overlapping merge accepted"
+else
+  grep -q overlap "$work/err" && [ ! -e "$work/bad.exr" ] && echo "ok   overlapping ranges refused" || fail "overlap message: $(cat "$work/err")"
+fi
+
+[ $fails -eq 0 ] && echo "resume and merge checks pass"
+exit $((fails > 0))
