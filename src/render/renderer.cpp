@@ -192,6 +192,22 @@ void Renderer::uploadScene(const Scene& scene) {
 
   // ---- Device buffers ----
   std::uint64_t pixels = std::uint64_t(m_settings.width) * m_settings.height;
+  // Refuse before allocating when the render cannot fit the device: a clear message instead of
+  // an allocation failure halfway (or the driver swapping).
+  {
+    const std::uint64_t cap = m_capacity;
+    std::uint64_t need = std::max<std::size_t>(bvh.nodes.size(), 1) * sizeof(BvhNode) + tris.size() * sizeof(GpuTriangle) +
+                         shading.size() * sizeof(GpuTriShading) + materials.size() * sizeof(GpuMaterial) +
+                         lights.size() * sizeof(GpuLight) + cdf.size() * 4 + pixels * 32 + cap * 9 * 16 +
+                         (QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + usedModels.size()) * cap) * 4;
+    std::uint64_t have = vk::deviceLocalHeapSize(m_ctx);
+    auto mib = [](std::uint64_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
+    if (have && need > have)
+      throw Error("the render needs about " + mib(need) + " of device memory (" + std::to_string(triCount) +
+                  " triangles, " + std::to_string(m_settings.width) + "x" + std::to_string(m_settings.height) +
+                  " pixels) but " + m_ctx.deviceName + " has " + mib(have) +
+                  ": use a smaller image or a simpler scene");
+  }
   auto make = [&](VkDeviceSize bytes, const std::string& what, const void* data = nullptr,
                   VkBufferUsageFlags usage = 0, bool host = false) -> vk::Buffer* {
     m_buffers.push_back(vk::createBuffer(m_ctx, bytes, usage, host, what));

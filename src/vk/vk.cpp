@@ -1,6 +1,7 @@
 // vk.cpp: instance, device, buffers and compute pipelines.
 #include "vk/vk.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 
@@ -362,6 +363,14 @@ Buffer createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags extraUsa
   addr.buffer = b.buffer;
   b.address = vkGetBufferDeviceAddress(ctx.device, &addr);
   return b;
+}
+
+VkDeviceSize deviceLocalHeapSize(const Context& ctx) {
+  VkDeviceSize best = 0;
+  for (std::uint32_t h = 0; h < ctx.memory.memoryHeapCount; ++h)
+    if (ctx.memory.memoryHeaps[h].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+      best = std::max(best, ctx.memory.memoryHeaps[h].size);
+  return best;
 }
 
 void destroyBuffer(Context& ctx, Buffer& b) {

@@ -70,6 +70,8 @@ struct Buffer {
 Buffer createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags extraUsage, bool hostVisible,
                     const std::string& what);
 void destroyBuffer(Context& ctx, Buffer& buffer);
+// Size of the largest device-local memory heap: what one render's buffers must fit into.
+VkDeviceSize deviceLocalHeapSize(const Context& ctx);
 // Copies bytes into a buffer (through a staging buffer when it is not host visible).
 void uploadBuffer(Context& ctx, Buffer& buffer, const void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
 void downloadBuffer(Context& ctx, const Buffer& buffer, void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);

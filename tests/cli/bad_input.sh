@@ -50,6 +50,7 @@ expect_error unknown_camera "no-such-camera" -- --camera no-such-camera
 expect_error bad_output_dir "$work/no/such/dir" -- -o "$work/no/such/dir/x.exr"
 expect_error bad_lighting "--lighting" -- --lighting nonsense
 expect_error width_zero "--width" -- --width 0
+expect_error device_memory "device memory" -- --width 60000 --height 4000
 
 # Degenerate geometry is not an error: dropped, counted in one warning, and the scene renders.
 out=$work/degenerate.exr
