@@ -416,8 +416,10 @@ int benchRenderCommand(const BenchArgs& a) {
     s.width = a.width;
     s.height = a.height;
     s.spp = a.spp;
+    s.timeStages = true;
     Renderer r(ctx, scene, s);
     r.renderPass();  // warm-up: lavapipe compiles each pipeline at its first dispatch
+    std::vector<std::pair<std::string, double>> warm = r.stageSeconds();
     RenderStats before = r.stats();
     auto t0 = std::chrono::steady_clock::now();
     for (std::uint32_t i = 0; i < a.spp; ++i) r.renderPass();
@@ -429,6 +431,16 @@ int benchRenderCommand(const BenchArgs& a) {
     std::snprintf(size, sizeof size, "%ux%u", s.width, s.height);
     std::printf("%-40s %10zu %9s %8u %10.3f %12.0f %12.3f\n", path.empty() ? "default (cornell-box)" : path.c_str(),
                 r.summary().triangles, size, a.spp, sec, samples / sec, rays / sec / 1e6);
+    std::string stages;
+    for (auto& [name, t] : r.stageSeconds()) {
+      double before = 0;
+      for (auto& [n0, t0] : warm)
+        if (n0 == name) before = t0;
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%s%s %.1f%%", stages.empty() ? "" : ", ", name.c_str(), 100.0 * (t - before) / sec);
+      stages += buf;
+    }
+    if (!stages.empty()) std::printf("    GPU time by stage: %s\n", stages.c_str());
   }
   vk::destroyContext(ctx);
   return kExitOk;

@@ -61,12 +61,28 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   VK_CHECK(vkAllocateCommandBuffers(m_ctx.device, &ai, &m_cmd));
   VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VK_CHECK(vkCreateFence(m_ctx.device, &fci, nullptr, &m_fence));
+  if (settings.timeStages && m_ctx.properties.limits.timestampComputeAndGraphics) {
+    m_queryCapacity = 8 + (settings.maxDepth + 1) * 8;
+    VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    q.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    q.queryCount = m_queryCapacity;
+    VK_CHECK(vkCreateQueryPool(m_ctx.device, &q, nullptr, &m_queryPool));
+  }
+}
+
+void Renderer::mark(VkCommandBuffer cmd, const char* stage) {
+  if (!m_queryPool) return;
+  std::uint32_t index = static_cast<std::uint32_t>(m_marks.size()) + 1;
+  if (stage == nullptr) index = 0;  // the start
+  else m_marks.push_back(stage);
+  if (index < m_queryCapacity) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_queryPool, index);
 }
 
 Renderer::~Renderer() {
   VkDevice d = m_ctx.device;
   vkDeviceWaitIdle(d);
   if (m_fence) vkDestroyFence(d, m_fence, nullptr);
+  if (m_queryPool) vkDestroyQueryPool(d, m_queryPool, nullptr);
   if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
   for (auto* p : {&m_camera, &m_submit, &m_intersect, &m_shadow, &m_accumulate}) vk::destroyComputePipeline(m_ctx, *p);
   for (auto& p : m_shade) vk::destroyComputePipeline(m_ctx, p);
@@ -383,6 +399,9 @@ void Renderer::recordPass(VkCommandBuffer cmd, std::uint32_t chunkStart, std::ui
   (void)chunkStart;
   const std::uint32_t slots = static_cast<std::uint32_t>(m_slotModels.size());
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_pipelineLayout, 0, 1, &m_set, 0, nullptr);
+  m_marks.clear();
+  if (m_queryPool) vkCmdResetQueryPool(cmd, m_queryPool, 0, m_queryCapacity);
+  mark(cmd, nullptr);
   // All queues start empty.
   vkCmdFillBuffer(cmd, m_queues->buffer, 0, QUEUE_HEADER_UINTS * 4, 0);
   vk::computeBarrier(cmd);
@@ -396,32 +415,40 @@ void Renderer::recordPass(VkCommandBuffer cmd, std::uint32_t chunkStart, std::ui
   bindAndPush(m_camera);
   vkCmdDispatch(cmd, groups, 1, 1);
   vk::computeBarrier(cmd);
+  mark(cmd, "camera");
 
   for (std::uint32_t bounce = 0; bounce <= m_settings.maxDepth; ++bounce) {
     const std::uint32_t rayQueue = bounce & 1u;
     pc.bounce = bounce;
     // intersect <- ray queue; empties the shadow queue of the previous bounce.
     dispatchSubmit(cmd, rayQueue, QUEUE_SHADOW, 1, 0, 0);
+    mark(cmd, "submit");
     bindAndPush(m_intersect);
     vkCmdDispatchIndirect(cmd, m_args->buffer, rayQueue * sizeof(DispatchArgs));
     vk::computeBarrier(cmd);
+    mark(cmd, "intersect");
     // shade(model) <- shade queues; empties the consumed ray queue.
     dispatchSubmit(cmd, INVALID_INDEX, rayQueue, 1, QUEUE_SHADE_BASE, slots);
+    mark(cmd, "submit");
     for (std::uint32_t s = 0; s < slots; ++s) {
       pc.modelSlot = s;
       bindAndPush(m_shade[s]);
       vkCmdDispatchIndirect(cmd, m_args->buffer, (QUEUE_SHADE_BASE + s) * sizeof(DispatchArgs));
     }
     vk::computeBarrier(cmd);
+    mark(cmd, "shade");
     // shadow <- shadow queue; empties the shade queues.
     dispatchSubmit(cmd, QUEUE_SHADOW, QUEUE_SHADE_BASE, slots, 0, 0);
+    mark(cmd, "submit");
     bindAndPush(m_shadow);
     vkCmdDispatchIndirect(cmd, m_args->buffer, QUEUE_SHADOW * sizeof(DispatchArgs));
     vk::computeBarrier(cmd);
+    mark(cmd, "shadow");
   }
   bindAndPush(m_accumulate);
   vkCmdDispatch(cmd, groups, 1, 1);
   vk::computeBarrier(cmd);
+  mark(cmd, "accumulate");
 }
 
 void Renderer::renderPass() {
@@ -446,6 +473,19 @@ void Renderer::renderPass() {
     VK_CHECK(vkResetFences(m_ctx.device, 1, &m_fence));
     VK_CHECK(vkQueueSubmit(m_ctx.queue, 1, &si, m_fence));
     VK_CHECK(vkWaitForFences(m_ctx.device, 1, &m_fence, VK_TRUE, UINT64_MAX));
+    if (m_queryPool && !m_marks.empty()) {
+      std::uint32_t n = std::min<std::uint32_t>(static_cast<std::uint32_t>(m_marks.size()) + 1, m_queryCapacity);
+      std::vector<std::uint64_t> t(n);
+      VK_CHECK(vkGetQueryPoolResults(m_ctx.device, m_queryPool, 0, n, n * 8, t.data(), 8,
+                                     VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+      const double period = m_ctx.properties.limits.timestampPeriod * 1e-9;
+      for (std::uint32_t i = 1; i < n; ++i) {
+        const char* name = m_marks[i - 1];
+        auto it = std::find_if(m_stageSeconds.begin(), m_stageSeconds.end(), [&](auto& e) { return e.first == name; });
+        if (it == m_stageSeconds.end()) it = m_stageSeconds.insert(m_stageSeconds.end(), {name, 0.0});
+        it->second += double(t[i] - t[i - 1]) * period;
+      }
+    }
     // Fold the 32-bit device counters into 64-bit totals and restart them.
     std::uint32_t* s = static_cast<std::uint32_t*>(m_stats->mapped);
     m_totals.rays += s[STAT_RAYS];

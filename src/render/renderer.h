@@ -26,6 +26,8 @@ struct RenderSettings {
   // Sample indices of this render start here (`--spp-offset`): a frame can be split across
   // machines into disjoint sample ranges and merged (`nusselt merge`).
   std::uint32_t sampleOffset = 0;
+  // Time every stage with GPU timestamps (stageSeconds()); for benchmarks.
+  bool timeStages = false;
   // Paths traced together in one chunk of a pass (path state memory ~128 bytes each).
   std::uint32_t maxPathsPerChunk = 1u << 20;
 };
@@ -70,6 +72,9 @@ class Renderer {
   // Adds counts carried over from a resumed render to the statistics.
   void addStats(const RenderStats& carried);
   RenderStats stats() const;
+  // GPU time per stage name (camera, submit, intersect, shade, shadow, accumulate) summed over
+  // all passes so far; empty unless RenderSettings::timeStages.
+  const std::vector<std::pair<std::string, double>>& stageSeconds() const { return m_stageSeconds; }
   const SceneSummary& summary() const { return m_summary; }
   const RenderSettings& settings() const { return m_settings; }
 
@@ -120,6 +125,11 @@ class Renderer {
   vk::ComputePipeline m_camera, m_submit, m_intersect, m_shadow, m_accumulate;
   std::vector<vk::ComputePipeline> m_shade;  // one per slot
   VkCommandBuffer m_cmd = VK_NULL_HANDLE;
+  VkQueryPool m_queryPool = VK_NULL_HANDLE;
+  std::uint32_t m_queryCapacity = 0;
+  std::vector<const char*> m_marks;  // stage name of each timestamp after the first
+  std::vector<std::pair<std::string, double>> m_stageSeconds;
+  void mark(VkCommandBuffer cmd, const char* stage);
   VkFence m_fence = VK_NULL_HANDLE;
 };
 

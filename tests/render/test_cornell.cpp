@@ -3,6 +3,9 @@
 // the chosen per-pixel significance (binomial bound), not a hand-tuned tolerance.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
+
 #include "../support/test_support.h"
 #include "scene/gltf_loader.h"
 
@@ -61,4 +64,24 @@ TEST(Cornell, ChunkedPassesEqualOneChunk) {
   s.maxPathsPerChunk = 100;  // 480 pixels in 5 chunks
   test::Rendered chunked = test::render(scene, s);
   EXPECT_EQ(0, std::memcmp(whole.image.rgb.data(), chunked.image.rgb.data(), whole.image.rgb.size() * sizeof(float)));
+}
+
+TEST(Cornell, StageTimestampsCoverEveryStage) {
+  Scene scene = loadSceneFromMemory(kDefaultSceneBytes, kDefaultSceneSize, "default scene");
+  RenderSettings s;
+  s.width = 16;
+  s.height = 16;
+  s.spp = 2;
+  s.timeStages = true;
+  Renderer r(test::context(), scene, s);
+  r.renderPass();
+  r.renderPass();
+  std::vector<std::string> names;
+  for (auto& [name, seconds] : r.stageSeconds()) {
+    names.push_back(name);
+    EXPECT_GE(seconds, 0.0) << name;
+  }
+  for (const char* stage : {"camera", "submit", "intersect", "shade", "shadow", "accumulate"})
+    EXPECT_NE(std::find(names.begin(), names.end(), stage), names.end()) << stage;
+  EXPECT_EQ(test::validationMessages(), 0u);
 }
