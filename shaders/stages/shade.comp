@@ -98,14 +98,17 @@ void main() {
   vec3 wiLocal;
   vec3 weight;
   float pdf;
-  if (!bsdfSample(MODEL_ID, M.params, wo, uB, wiLocal, weight, pdf)) return;
+  float q;
+  if (!bsdfSample(MODEL_ID, M.params, wo, !frontFace, uB, wiLocal, weight, pdf, q)) return;
   vec3 wi = toWorld(wiLocal, tt, bb, ns);
-  if (dot(wi, ng) <= 0.0f) return;  // below the geometric surface: would leak light
+  // Reflection must stay above the geometric surface (else light leaks through it); refraction
+  // (only delta models transmit) must cross it, and leaves from the other side.
+  bool transmitted = wiLocal.z < 0.0f;
+  if (transmitted != (dot(wi, ng) < 0.0f)) return;
+  if (transmitted) xo = offsetRay(x, -ng);
 
-  // ---- Russian roulette: continue with probability = luminance of the sample weight ----
-  // With sampling proportional to f cos, the weight is the directional albedo: the random-walk
-  // source's albedo roulette. Surviving paths are divided by the probability (unbiased).
-  float q = min(1.0f, luminance(weight));
+  // ---- Russian roulette with the continuation probability of the sample (the albedo) ----
+  // Surviving paths are divided by the probability (unbiased).
   float uR = rng1(pixel, sampleIndex, rngDimension(bounce, RNG_DIM_ROULETTE), seed);
   if (!(q > 0.0f) || uR >= q) return;
   beta *= weight / q;
