@@ -151,6 +151,7 @@ struct Globals {
   uvec4 image;      // width, height, first pixel of this chunk, pixels in this chunk
   uvec4 frame;      // sample index of this pass, seed, max depth, path capacity
   uvec4 counts;     // materials, lights, triangles, lighting mode (LIGHTING_*)
+  uvec4 options;    // random numbers (RNG_PCG / RNG_QMC), 0, 0, 0
   vec4 camPosition; // xyz, w = 1 for orthographic
   vec4 camRight;    // unit right * (tan(yfov/2) * aspect), or * xmag for orthographic
   vec4 camUp;       // unit up * tan(yfov/2), or * ymag for orthographic
@@ -185,7 +186,7 @@ struct Globals {
   BUFREF(QuadLeaves) quadLeaves;
   BUFREF(Uints) display;       // the preview's RGBA8 display buffer (0 when headless)
 };
-STATIC_ASSERT_SIZE(Globals, 48 + 7 * 16 + 25 * 8);
+STATIC_ASSERT_SIZE(Globals, 64 + 7 * 16 + 25 * 8);
 
 // Push constants of every stage.
 struct StageConstants {

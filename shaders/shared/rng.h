@@ -47,5 +47,69 @@ SHARED_FN float rng1(uint pixel, uint sampleIndex, uint dimension, uint seed) {
   return rng2(pixel, sampleIndex, dimension, seed).x;
 }
 
+// ---- Quasi-Monte Carlo: padded, Owen-scrambled Sobol (0,2)-sequences ----------------------------
+// Each 2D draw (a dimension of rngDimension) gets its own copy of the first two Sobol
+// dimensions, a (0,2)-sequence, with the sample index shuffled and both coordinates Owen
+// scrambled by hashes of (pixel, dimension, seed) (Burley, "Practical Hash-based Owen
+// Scrambling", JCGT 9(4), 2020; pbrt-v4's PaddedSobolSampler). Every decision of the walk (light
+// choice, light point, BSDF direction, roulette, component choice) has its own dimension, so
+// each keeps its stratification over the samples of a pixel, as the random-walk source asks.
+#define RNG_PCG 0u
+#define RNG_QMC 1u
+
+SHARED_FN uint rngReverseBits(uint x) {
+  x = ((x >> 1u) & 0x55555555u) | ((x & 0x55555555u) << 1u);
+  x = ((x >> 2u) & 0x33333333u) | ((x & 0x33333333u) << 2u);
+  x = ((x >> 4u) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4u);
+  x = ((x >> 8u) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8u);
+  return (x >> 16u) | (x << 16u);
+}
+
+// Laine-Karras style hash that only propagates bits upwards: on bit-reversed values it is a
+// nested uniform (Owen) scramble.
+SHARED_FN uint rngLaineKarras(uint x, uint seed) {
+  x += seed;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return x;
+}
+
+SHARED_FN uint rngOwenScramble(uint x, uint seed) {
+  return rngReverseBits(rngLaineKarras(rngReverseBits(x), seed));
+}
+
+// Second Sobol dimension: generator rows v0 = 2^31, v(i+1) = v(i) ^ (v(i) >> 1).
+// At most 32 iterations (one per set bit of the index).
+SHARED_FN uint rngSobol1(uint index) {
+  uint r = 0u;
+  uint v = 0x80000000u;
+  for (int i = 0; i < 32 && index != 0u; ++i) {
+    if ((index & 1u) != 0u) r ^= v;
+    index >>= 1u;
+    v ^= v >> 1u;
+  }
+  return r;
+}
+
+SHARED_FN vec2 qmc2(uint pixel, uint sampleIndex, uint dimension, uint seed) {
+  uvec4 h = pcg4d(uvec4(pixel, dimension, seed, 0x9e3779b9u));
+  uint index = rngOwenScramble(sampleIndex, h.x);  // shuffles the order of the points
+  uint x = rngOwenScramble(rngReverseBits(index), h.y);
+  uint y = rngOwenScramble(rngSobol1(index), h.z);
+  return vec2(float(x >> 8u), float(y >> 8u)) * (1.0f / 16777216.0f);
+}
+
+// The sampler of a render: independent PCG hashes or QMC.
+SHARED_FN vec2 sample2(uint mode, uint pixel, uint sampleIndex, uint dimension, uint seed) {
+  if (mode == RNG_QMC) return qmc2(pixel, sampleIndex, dimension, seed);
+  return rng2(pixel, sampleIndex, dimension, seed);
+}
+
+SHARED_FN float sample1(uint mode, uint pixel, uint sampleIndex, uint dimension, uint seed) {
+  return sample2(mode, pixel, sampleIndex, dimension, seed).x;
+}
+
 SHARED_END
 #endif

@@ -13,7 +13,7 @@ void main() {
   uint py = pixel / width;
 
   // Pixel jitter: dimensions 0 and 1 (box filter over the pixel).
-  vec2 u = rng2(pixel, g.frame.x, 0u, g.frame.y);
+  vec2 u = sample2(g.options.x, pixel, g.frame.x, 0u, g.frame.y);
   float sx = ((float(px) + u.x) / float(width)) * 2.0f - 1.0f;
   float sy = 1.0f - ((float(py) + u.y) / float(g.image.y)) * 2.0f;
 

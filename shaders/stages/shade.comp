@@ -19,6 +19,7 @@ void main() {
   uint sampleIndex = g.frame.x;
   uint seed = g.frame.y;
   uint lighting = g.counts.w;
+  uint rngMode = g.options.x;
 
   // ---- Hit geometry ----
   vec4 hit = g.pathHit.v[path];
@@ -69,8 +70,8 @@ void main() {
 
   // ---- Next-event estimation ----
   if (!last && lighting != LIGHTING_BSDF_ONLY && !modelIsDelta(MODEL_ID)) {
-    float uSel = rng1(pixel, sampleIndex, rngDimension(bounce, RNG_DIM_LIGHT_SELECT), seed);
-    vec2 uPt = rng2(pixel, sampleIndex, rngDimension(bounce, RNG_DIM_LIGHT_POINT), seed);
+    float uSel = sample1(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_LIGHT_SELECT), seed);
+    vec2 uPt = sample2(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_LIGHT_POINT), seed);
     LightSample ls;
     if (sampleLight(xo, uSel, uPt, ls) && dot(ls.wi, ng) > 0.0f) {
       vec3 wiL = toLocal(ls.wi, tt, bb, ns);
@@ -94,7 +95,7 @@ void main() {
   if (last) return;
 
   // ---- BSDF sampling: the next step of the random walk ----
-  vec2 uB = rng2(pixel, sampleIndex, rngDimension(bounce, RNG_DIM_BSDF), seed);
+  vec2 uB = sample2(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_BSDF), seed);
   vec3 wiLocal;
   vec3 weight;
   float pdf;
@@ -109,7 +110,7 @@ void main() {
 
   // ---- Russian roulette with the continuation probability of the sample (the albedo) ----
   // Surviving paths are divided by the probability (unbiased).
-  float uR = rng1(pixel, sampleIndex, rngDimension(bounce, RNG_DIM_ROULETTE), seed);
+  float uR = sample1(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_ROULETTE), seed);
   if (!(q > 0.0f) || uR >= q) return;
   beta *= weight / q;
 

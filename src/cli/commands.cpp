@@ -78,6 +78,7 @@ struct RenderArgs {
   std::uint32_t maxDepth = 8;
   int device = -1;
   std::string lighting = "mis";
+  std::string rng = "pcg";
   bool variance = false;
   bool validation = false;
   bool quiet = false;
@@ -110,6 +111,7 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
                   {"nusselt/integrator", "wavefront path tracer: NEE + BSDF sampling, MIS power heuristic, "
                                          "albedo Russian roulette"},
                   {"nusselt/lighting", lightingModeName(r.settings.lighting)},
+                  {"nusselt/rng", rngModeName(r.settings.rng)},
                   {"nusselt/sampler", "cosine"},
                   {"nusselt/models", r.models}};
   meta.ints = {{"nusselt/spp", r.spp},
@@ -146,6 +148,7 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   r.models = str("nusselt/models");
   std::string lighting = str("nusselt/lighting");
   r.settings.lighting = parseLighting(lighting);
+  r.settings.rng = findString(meta, "nusselt/rng").value_or("pcg") == "qmc" ? RngMode::Qmc : RngMode::Pcg;
   r.spp = static_cast<std::uint32_t>(num("nusselt/spp"));
   r.settings.sampleOffset = static_cast<std::uint32_t>(num("nusselt/sppOffset"));
   r.settings.seed = static_cast<std::uint32_t>(num("nusselt/seed"));
@@ -190,6 +193,7 @@ int renderCommand(const RenderArgs& a) {
   s.maxDepth = a.maxDepth;
   s.sampleOffset = a.sppOffset;
   s.lighting = parseLighting(a.lighting);
+  s.rng = a.rng == "qmc" ? RngMode::Qmc : RngMode::Pcg;
   // Image size: defaults follow the camera's aspect ratio when only one side (or none) is given.
   float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
   s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u);
@@ -213,6 +217,7 @@ int renderCommand(const RenderArgs& a) {
     mismatch("--seed", std::to_string(previous.settings.seed), std::to_string(s.seed));
     mismatch("--max-depth", std::to_string(previous.settings.maxDepth), std::to_string(s.maxDepth));
     mismatch("--lighting", lightingModeName(previous.settings.lighting), lightingModeName(s.lighting));
+    mismatch("--rng", rngModeName(previous.settings.rng), rngModeName(s.rng));
     mismatch("--spp-offset", std::to_string(previous.settings.sampleOffset), std::to_string(s.sampleOffset));
     if (saved.sum.empty() || saved.sumSq.empty())
       throw Error("--resume " + a.resume + ": no accumulation channels (sum.R/G/B, sumSq.R/G/B)");
@@ -244,10 +249,10 @@ int renderCommand(const RenderArgs& a) {
       std::fprintf(stderr, "scene: %s: %zu triangles, %zu materials (models: %s), %zu lights; BVH %u nodes in %.3f s\n",
                    scene.sourcePath.c_str(), sum.triangles, sum.materials, models.c_str(), sum.lights, sum.bvhNodes,
                    sum.bvhSeconds);
-      std::fprintf(stderr, "device: %s; %ux%u, %u spp%s, max depth %u, seed %u, lighting %s\n", ctx.deviceName.c_str(),
-                   s.width, s.height, s.spp,
+      std::fprintf(stderr, "device: %s; %ux%u, %u spp%s, max depth %u, seed %u, lighting %s, rng %s\n",
+                   ctx.deviceName.c_str(), s.width, s.height, s.spp,
                    a.resume.empty() ? "" : (" (resuming from " + std::to_string(previous.spp) + ")").c_str(),
-                   s.maxDepth, s.seed, lightingModeName(s.lighting));
+                   s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng));
     }
 
     auto tRender = std::chrono::steady_clock::now();
@@ -339,6 +344,7 @@ int mergeCommand(const std::vector<std::string>& inputs, const std::string& outp
       same("the seed", std::to_string(merged.settings.seed), std::to_string(r.settings.seed));
       same("the max depth", std::to_string(merged.settings.maxDepth), std::to_string(r.settings.maxDepth));
       same("the lighting", lightingModeName(merged.settings.lighting), lightingModeName(r.settings.lighting));
+      same("the random numbers", rngModeName(merged.settings.rng), rngModeName(r.settings.rng));
       for (std::size_t i = 0; i < total.sum.size(); ++i) {
         total.sum[i] += img.sum[i];
         total.sumSq[i] += img.sumSq[i];
@@ -504,6 +510,8 @@ int runCli(int argc, char** argv) {
   render->add_option("--spp-offset", ra.sppOffset, "First sample index of this render: split a frame across machines "
                                                    "into disjoint ranges and combine them with `nusselt merge`")
       ->capture_default_str();
+  render->add_option("--rng", ra.rng, "Random numbers: pcg (independent hashes) or qmc (padded Owen-scrambled Sobol)")
+      ->capture_default_str()->check(CLI::IsMember({"pcg", "qmc"}));
   render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
   render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
   render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");

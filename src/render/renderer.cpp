@@ -29,6 +29,8 @@ const char* lightingModeName(LightingMode mode) {
   return "?";
 }
 
+const char* rngModeName(RngMode mode) { return mode == RngMode::Qmc ? "qmc" : "pcg"; }
+
 namespace {
 
 double seconds(std::chrono::steady_clock::time_point a) {
@@ -290,6 +292,7 @@ void Renderer::uploadScene(const Scene& scene) {
   g.frame = glm::uvec4(0u, m_settings.seed, m_settings.maxDepth, m_capacity);
   g.counts = glm::uvec4(static_cast<std::uint32_t>(materials.size()), static_cast<std::uint32_t>(weights.size()),
                         static_cast<std::uint32_t>(triCount), static_cast<std::uint32_t>(m_settings.lighting));
+  g.options = glm::uvec4(static_cast<std::uint32_t>(m_settings.rng), 0u, 0u, 0u);
   m_globals.resize(sizeof(Globals));
   std::memcpy(m_globals.data(), &g, sizeof g);
   writeCamera(m_cameraState);

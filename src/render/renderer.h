@@ -15,6 +15,9 @@ namespace nusselt {
 
 enum class LightingMode : std::uint32_t { Mis = 0, NeeOnly = 1, BsdfOnly = 2 };
 const char* lightingModeName(LightingMode mode);
+// Random numbers: independent PCG hashes, or padded Owen-scrambled Sobol (quasi-Monte Carlo).
+enum class RngMode : std::uint32_t { Pcg = 0, Qmc = 1 };
+const char* rngModeName(RngMode mode);
 
 struct RenderSettings {
   std::uint32_t width = 512;
@@ -23,6 +26,7 @@ struct RenderSettings {
   std::uint32_t maxDepth = 8;       // pbrt's convention: 0 = emitted light only, 1 = direct light
   std::uint32_t seed = 0;
   LightingMode lighting = LightingMode::Mis;
+  RngMode rng = RngMode::Pcg;
   // Sample indices of this render start here (`--spp-offset`): a frame can be split across
   // machines into disjoint sample ranges and merged (`nusselt merge`).
   std::uint32_t sampleOffset = 0;

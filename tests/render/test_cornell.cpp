@@ -85,3 +85,24 @@ TEST(Cornell, StageTimestampsCoverEveryStage) {
     EXPECT_NE(std::find(names.begin(), names.end(), stage), names.end()) << stage;
   EXPECT_EQ(test::validationMessages(), 0u);
 }
+
+TEST(Cornell, QmcConvergesToTheSameImage) {
+  // Quasi-Monte Carlo samples are not independent, so their own variance estimate is not used:
+  // the reference's per-sample variance (independent PCG samples) stands in, an upper bound on
+  // the QMC error, which makes the test conservative, never loose.
+  ImageMetadata meta;
+  Image ref = readExr(test::sourcePath("tests/data/refs/cornell-box.exr"), &meta);
+  Scene scene = loadSceneFromMemory(kDefaultSceneBytes, kDefaultSceneSize, "default scene");
+  RenderSettings s;
+  s.width = ref.width;
+  s.height = ref.height;
+  s.spp = 128;
+  s.seed = 8;
+  s.rng = RngMode::Qmc;
+  s.maxDepth = static_cast<std::uint32_t>(findInt(meta, "nusselt/maxDepth").value_or(8));
+  test::Rendered r = test::render(scene, s);
+  const double refSpp = double(findInt(meta, "nusselt/spp").value_or(0));
+  std::string msg = test::compareImagesStatistically(r.image, ref, 0.01, 0.001, 1, refSpp / s.spp);
+  EXPECT_TRUE(msg.empty()) << msg;
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
