@@ -201,7 +201,9 @@ struct StageConstants {
 };
 STATIC_ASSERT_SIZE(StageConstants, 32);
 
-#ifndef __cplusplus
+// The wavefront stages see the globals at binding 0 and StageConstants as push constants.
+// A standalone kernel (tests, tools) defines NUSSELT_STANDALONE_KERNEL and declares its own.
+#if !defined(__cplusplus) && !defined(NUSSELT_STANDALONE_KERNEL)
 layout(set = 0, binding = 0, std430) readonly buffer GlobalsBlock { Globals g; };
 layout(push_constant, std430) uniform PushBlock { StageConstants pc; };
 #endif

@@ -68,6 +68,50 @@ SHARED_FN float cosFromSin(float s) { return safeSqrt((1.0f - s) * (1.0f + s)); 
 
 SHARED_FN float maxComponent(vec3 v) { return max(v.x, max(v.y, v.z)); }
 
+// ---- Inverse trigonometry that is the same on CPU and GPU -----------------------------------------
+// Vulkan lets asin, acos and atan be thousands of ulps off (their precision is inherited from an
+// approximated atan), and lavapipe's are ~1e-4 relative near +-1: a model written with the
+// built-ins would evaluate differently on the two sides. Shared code uses these instead: the same
+// float operations on both sides (Cephes' atanf polynomial, ~2e-7 relative), with asin and acos
+// through atan2 and sqrt((1 - x)(1 + x)), accurate near +-1.
+SHARED_FN float portableAtanUnit(float x) {  // x >= 0
+  float y = 0.0f;
+  float t = x;
+  if (x > 2.414213562373095f) {  // tan(3 pi / 8)
+    y = 1.5707963267948966f;
+    t = -1.0f / x;
+  } else if (x > 0.4142135623730950f) {  // tan(pi / 8)
+    y = 0.7853981633974483f;
+    t = (x - 1.0f) / (x + 1.0f);
+  }
+  float z = t * t;
+  return y + ((((8.05374449538e-2f * z - 1.38776856032e-1f) * z + 1.99777106478e-1f) * z - 3.33329491539e-1f) * z * t + t);
+}
+
+SHARED_FN float portableAtan(float x) { return x < 0.0f ? -portableAtanUnit(-x) : portableAtanUnit(x); }
+
+// atan2(y, x) in (-pi, pi]; 0 for (0, 0).
+SHARED_FN float portableAtan2(float y, float x) {
+  float ax = abs(x);
+  float ay = abs(y);
+  float a = 0.0f;
+  if (ax == 0.0f && ay == 0.0f) return 0.0f;
+  if (ay <= ax) a = portableAtanUnit(ay / ax);
+  else a = 1.5707963267948966f - portableAtanUnit(ax / ay);
+  if (x < 0.0f) a = 3.14159265358979323846f - a;
+  return y < 0.0f ? -a : a;
+}
+
+SHARED_FN float portableAsin(float x) {
+  x = clamp(x, -1.0f, 1.0f);
+  return portableAtan2(x, sqrt((1.0f - x) * (1.0f + x)));
+}
+
+SHARED_FN float portableAcos(float x) {
+  x = clamp(x, -1.0f, 1.0f);
+  return portableAtan2(sqrt((1.0f - x) * (1.0f + x)), x);
+}
+
 SHARED_END
 
 #endif

@@ -38,6 +38,25 @@ Rendered render(const Scene& scene, const RenderSettings& settings) {
   return {r.image(true), r.stats()};
 }
 
+void runKernel(const std::string& name, const std::vector<std::uint32_t>& specialization, const void* push,
+               std::uint32_t pushBytes, std::uint32_t invocations) {
+  vk::Context& ctx = context();
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushBytes};
+  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pl.pushConstantRangeCount = 1;
+  pl.pPushConstantRanges = &range;
+  VkPipelineLayout layout;
+  VK_CHECK(vkCreatePipelineLayout(ctx.device, &pl, nullptr, &layout));
+  vk::ComputePipeline p = vk::createComputePipeline(ctx, layout, name, specialization);
+  VkCommandBuffer cmd = vk::beginOneShot(ctx);
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+  vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, pushBytes, push);
+  vkCmdDispatch(cmd, (invocations + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE, 1, 1);
+  vk::endOneShot(ctx, cmd);
+  vk::destroyComputePipeline(ctx, p);
+  vkDestroyPipelineLayout(ctx.device, layout, nullptr);
+}
+
 double normalPValue(double z) { return std::erfc(std::fabs(z) / std::sqrt(2.0)); }
 
 double normalQuantileUpper(double p) {

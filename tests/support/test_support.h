@@ -24,6 +24,12 @@ struct Rendered {
 };
 Rendered render(const Scene& scene, const RenderSettings& settings);
 
+// Runs an embedded standalone compute kernel (one that declares its own push-constant block of at
+// most 128 bytes, typically buffer device addresses, and no descriptor sets) over `invocations`
+// threads, with the given specialization constants, and waits for it.
+void runKernel(const std::string& name, const std::vector<std::uint32_t>& specialization, const void* push,
+               std::uint32_t pushBytes, std::uint32_t invocations);
+
 // Two-sided p-value of a standard normal z.
 double normalPValue(double z);
 // Inverse of the upper tail of the standard normal: z with P(Z > z) = p.
