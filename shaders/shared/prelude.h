@@ -68,6 +68,29 @@ SHARED_FN float cosFromSin(float s) { return safeSqrt((1.0f - s) * (1.0f + s)); 
 
 SHARED_FN float maxComponent(vec3 v) { return max(v.x, max(v.y, v.z)); }
 
+// ---- A logarithm that is the same on CPU and GPU ------------------------------------------------
+// Vulkan allows log/log2 an ABSOLUTE error of 2^-21 for arguments in [0.5, 2] (lavapipe's is of
+// that order), so log of a lobe's cosine near 1, multiplied by an exponent of 5000, would differ
+// by 0.1 % between the two builds. Here: x = m 2^e (frexp, exact), m in [0.707, 1.414), and
+// log(m) = 2 atanh(z), z = (m - 1)/(m + 1), |z| <= 0.172, by its series (7 terms: truncation
+// below 1e-12); ln 2 split in two for accuracy. Returns -3.4e38 (not -inf: no 0 * inf NaN in
+// exp(n log x) with n = 0) for x <= 0.
+SHARED_FN float portableLog(float x) {
+  if (!(x > 0.0f)) return -3.4e38f;
+  int e = 0;
+  float m = frexp(x, e);
+  if (m < 0.70710678f) {
+    m *= 2.0f;
+    e -= 1;
+  }
+  float z = (m - 1.0f) / (m + 1.0f);
+  float z2 = z * z;
+  float s = 2.0f * z * (1.0f + z2 * (1.0f / 3.0f + z2 * (1.0f / 5.0f + z2 * (1.0f / 7.0f + z2 * (1.0f / 9.0f +
+            z2 * (1.0f / 11.0f + z2 * (1.0f / 13.0f)))))));
+  float fe = float(e);
+  return (fe * 0.693145751953125f + s) + fe * 1.428606765330187e-06f;
+}
+
 // ---- Inverse trigonometry that is the same on CPU and GPU -----------------------------------------
 // Vulkan lets asin, acos and atan be thousands of ulps off (their precision is inherited from an
 // approximated atan), and lavapipe's are ~1e-4 relative near +-1: a model written with the

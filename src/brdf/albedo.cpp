@@ -80,7 +80,7 @@ double adaptive(const F& f, const std::vector<double>& breaks, double relTol, do
 std::vector<double> gradedBreaks(double lo, double hi, double x0) {
   std::vector<double> b = {lo, hi};
   if (x0 >= lo && x0 <= hi) b.push_back(x0);
-  for (double d = 1e-5; d < hi - lo; d *= 4.0) {
+  for (double d = 1e-5; d < hi - lo; d *= 6.0) {
     if (x0 - d > lo) b.push_back(x0 - d);
     if (x0 + d < hi) b.push_back(x0 + d);
   }
@@ -95,40 +95,55 @@ template <class G>
 double hemisphere(const G& g, double thetaI, double phiI, AlbedoMethod method, double relTol) {
   const double pi = M_PI;
   const double phiM = phiI + pi;             // mirror azimuth
-  const double sM = std::sqrt(std::cos(thetaI));  // mirror direction's s
-  auto integrand = [&](double s, double phi) {
-    double u = s * s;
-    double st = std::sqrt(std::max(0.0, (1.0 - u) * (1.0 + u)));
+  // u = cos(theta_o) = sin^2(pi t / 2): u ~ t^2 at the rim (absorbs 1/sqrt(u) and 1/u factors
+  // times the cosine) and theta_o ~ (1 - t) at the pole (regular there; sqrt(u) was not).
+  const double tM = 2.0 / pi * std::asin(std::sqrt(std::cos(thetaI)));  // mirror direction's t
+  auto integrand = [&](double t, double phi) {
+    double sn = std::sin(0.5 * pi * t), cs = std::cos(0.5 * pi * t);
+    double u = sn * sn;
+    double st = cs * std::sqrt(1.0 + u);  // sin(theta_o) = sqrt((1 - u)(1 + u)), 1 - u = cs^2
     vec3 wo(static_cast<float>(st * std::cos(phi)), static_cast<float>(st * std::sin(phi)), static_cast<float>(u));
     if (!(wo.z > 0.0f)) return 0.0;
-    return g(wo) * u * 2.0 * s;
+    return g(wo) * u * pi * sn * cs;  // du/dt = pi sin cos
   };
-  std::vector<double> sBreaks = gradedBreaks(0.0, 1.0, sM);
+  std::vector<double> sBreaks = gradedBreaks(0.0, 1.0, tM);
+  for (double d = 1e-4; d < 0.5; d *= 8.0) sBreaks.push_back(1.0 - d);  // the pole
+  std::sort(sBreaks.begin(), sBreaks.end());
+  sBreaks.erase(std::unique(sBreaks.begin(), sBreaks.end()), sBreaks.end());
   std::vector<double> pBreaks = gradedBreaks(phiM - pi, phiM + pi, phiM);
-  // Also the axes (anisotropic lobes are aligned with x and y; at normal incidence the mirror
-  // azimuth says nothing).
+  // Also graded towards the axes: anisotropic lobes (ward, ashikhmin_shirley, schlick p < 1) are
+  // sheets along the x-z or y-z plane, peaked at those azimuths on both sides.
   for (int k = -4; k <= 4; ++k) {
     double a = k * 0.5 * pi;
-    if (a > phiM - pi && a < phiM + pi) pBreaks.push_back(a);
+    if (a <= phiM - pi || a >= phiM + pi) continue;
+    pBreaks.push_back(a);
+    for (double d = 1e-3; d < 0.5; d *= 16.0) {
+      if (a - d > phiM - pi) pBreaks.push_back(a - d);
+      if (a + d < phiM + pi) pBreaks.push_back(a + d);
+    }
   }
   std::sort(pBreaks.begin(), pBreaks.end());
+  pBreaks.erase(std::unique(pBreaks.begin(), pBreaks.end()), pBreaks.end());
   // Float evaluation noise is ~1e-7 relative: no tolerance below that. The inner integrals get an
   // absolute tolerance relative to the whole (a coarse first pass gives its scale).
-  auto nested = [&](double outerRel, double innerRel, double innerAbs, int maxPieces) {
+  // The inner integrals are capped at fewer pieces than the outer one: a model whose float
+  // evaluation is not smooth at the 1e-7 level (poulin_fournier's panel quadrature) would
+  // otherwise spend its time refining noise.
+  auto nested = [&](double outerRel, double innerRel, double innerAbs, int outerMax, int innerMax) {
     if (method == AlbedoMethod::ThetaOuter) {
       auto outer = [&](double s) {
-        return adaptive([&](double phi) { return integrand(s, phi); }, pBreaks, innerRel, innerAbs, maxPieces);
+        return adaptive([&](double phi) { return integrand(s, phi); }, pBreaks, innerRel, innerAbs, innerMax);
       };
-      return adaptive(outer, sBreaks, outerRel, innerAbs, maxPieces);
+      return adaptive(outer, sBreaks, outerRel, innerAbs, outerMax);
     }
     auto outer = [&](double phi) {
-      return adaptive([&](double s) { return integrand(s, phi); }, sBreaks, innerRel, innerAbs, maxPieces);
+      return adaptive([&](double s) { return integrand(s, phi); }, sBreaks, innerRel, innerAbs, innerMax);
     };
-    return adaptive(outer, pBreaks, outerRel, innerAbs, maxPieces);
+    return adaptive(outer, pBreaks, outerRel, innerAbs, outerMax);
   };
-  double coarse = std::abs(nested(1e-3, 1e-4, 0.0, 60));
+  double coarse = std::abs(nested(1e-3, 1e-4, 0.0, 60, 60));
   if (coarse == 0.0) return 0.0;
-  return nested(relTol, 2e-7, 0.1 * relTol * coarse, 300);
+  return nested(relTol, 2e-7, 0.1 * relTol * coarse, 300, 100);
 }
 
 vec3 incident(double thetaDeg, double phiDeg) {
@@ -138,6 +153,37 @@ vec3 incident(double thetaDeg, double phiDeg) {
 }
 
 constexpr double kRelTol = 1e-6;
+
+// The specular albedo of coupled, a_s = f0 A1 + A2, at incidence cosine ci, integrated over the
+// half vector: f_s co dw_o = F D co / cb dw_h, and D ch dw_h = dv dphi / (2 pi) with
+// tan^2(theta_h) = -m^2 ln(1 - v). The integrand F co / (cb ch) [co > 0] is bounded (<= 2 F) and
+// smooth but for the kink where wo crosses the horizon; symmetric in phi (wi in the x-z plane).
+void coupledSpecularAlbedo(double m, double ci, double& A1, double& A2) {
+  const double si = std::sqrt(std::max(0.0, 1.0 - ci * ci));
+  double sums[2];
+  for (int which = 0; which < 2; ++which) {
+    auto integrand = [&](double v, double phi) {
+      double tan2 = -m * m * std::log1p(-v);
+      double ch = 1.0 / std::sqrt(1.0 + tan2), sh = std::sqrt(tan2) * ch;
+      double hx = sh * std::cos(phi), hz = ch;
+      double cb = si * hx + ci * hz;
+      if (cb <= 0.0) return 0.0;
+      double co = 2.0 * cb * hz - ci;
+      if (co <= 0.0) return 0.0;
+      double w = std::pow(1.0 - cb, 5.0);
+      double F = which == 0 ? 1.0 - w : w;  // A1: f0 (1 - w); A2: w
+      return F * co / (cb * ch);
+    };
+    std::vector<double> vBreaks = {0.0, 0.5, 0.9, 0.99, 0.999, 0.9999, 1.0};
+    std::vector<double> pBreaks = {0.0, 0.5 * M_PI, 0.9 * M_PI, 0.99 * M_PI, M_PI};
+    auto inner = [&](double v) {
+      return adaptive([&](double phi) { return integrand(v, phi); }, pBreaks, 1e-8, 1e-10, 200);
+    };
+    sums[which] = adaptive(inner, vBreaks, 1e-7, 1e-10, 200) / M_PI;  // 2 * int_0^pi / (2 pi)
+  }
+  A1 = sums[0];
+  A2 = sums[1];
+}
 
 }  // namespace
 
@@ -181,14 +227,10 @@ void fillCoupledTables(BrdfParams& p) {
     table.assign(2 * COUPLED_TABLE_SIZE + 2, 0.0f);
     for (int j = 0; j < COUPLED_TABLE_SIZE; ++j) {
       double x = coupledTableX(j);
-      double c = x * x, t = std::acos(std::min(c, 1.0));
-      vec3 wi(static_cast<float>(std::sin(t)), 0.0f, static_cast<float>(c));
-      double one = hemisphere([&](vec3 wo) { return double(coupledSpecular(vec3(1.0f), m, wi, wo).x); }, t, 0.0,
-                              AlbedoMethod::ThetaOuter, 1e-6);
-      double zero = hemisphere([&](vec3 wo) { return double(coupledSpecular(vec3(0.0f), m, wi, wo).x); }, t, 0.0,
-                               AlbedoMethod::ThetaOuter, 1e-6);
-      table[j] = static_cast<float>(one - zero);
-      table[COUPLED_TABLE_SIZE + j] = static_cast<float>(zero);
+      double A1, A2;
+      coupledSpecularAlbedo(m, x * x, A1, A2);
+      table[j] = static_cast<float>(A1);
+      table[COUPLED_TABLE_SIZE + j] = static_cast<float>(A2);
     }
     // abar = 2 int_0^1 a(c) c dc = int_0^1 4 x^3 a(x) dx with a piecewise linear in x = sqrt(c):
     // exact with 3-point Gauss-Legendre per segment (degree 4); below x_0 a is constant a_0.

@@ -7,10 +7,11 @@
 
 namespace nusselt {
 
-// Two independent quadratures: nested adaptive Gauss-Kronrod (7-15) over u = cos(theta_o) = s^2
-// (s in [0, 1], removes the rim singularities of ward92/duer/minnaert/schlick/beard_maxwell) and
-// the azimuth phi_o, with the peak (mirror direction) as a breakpoint of both. ThetaOuter
-// integrates phi inside s; PhiOuter integrates s inside phi.
+// Two independent quadratures: nested adaptive Gauss-Kronrod (7-15) over t with
+// u = cos(theta_o) = sin^2(pi t / 2) (t in [0, 1]; u ~ t^2 at the rim removes the rim
+// singularities of ward92/duer/minnaert/schlick/beard_maxwell, and t is regular at the pole) and
+// the azimuth phi_o, with breakpoints graded towards the peak (mirror direction), the pole and the
+// axes (anisotropic sheets). ThetaOuter integrates phi inside t; PhiOuter t inside phi.
 enum class AlbedoMethod { ThetaOuter, PhiOuter };
 
 // a(wi) = integral over the hemisphere of luminance(f(wi, wo)) cos(theta_o) dw_o for

@@ -24,3 +24,18 @@ TEST(Prelude, PortableInverseTrigonometryIsAccurate) {
       EXPECT_NEAR(portableAtan2(y, x), std::atan2(double(y), double(x)), 4e-7 * M_PI) << y << ", " << x;
     }
 }
+
+TEST(Prelude, PortableLogIsAccurate) {
+  double worst = 0;
+  for (float x = 1e-30f; x < 1e30f; x *= 1.0137f) {
+    double exact = std::log(double(x));
+    worst = std::max(worst, std::fabs(portableLog(x) - exact) / std::max(1e-3, std::fabs(exact)));
+  }
+  for (int i = 1; i < 100000; ++i) {  // near 1, where the absolute error matters
+    float x = 0.5f + float(i) / 66666.0f;
+    double exact = std::log(double(x));
+    if (exact != 0) worst = std::max(worst, std::fabs(portableLog(x) - exact) / std::fabs(exact));
+  }
+  EXPECT_LT(worst, 8 * std::ldexp(1.0, -23));
+  EXPECT_EQ(portableLog(0.0f), -3.4e38f);
+}

@@ -25,7 +25,7 @@ SHARED_FN vec3 ashikhminShirleyEval(BrdfParams p, vec3 wi, vec3 wo) {
   float nu = brdfParam(p, ASHIKHMIN_SHIRLEY_NU);
   float nv = brdfParam(p, ASHIKHMIN_SHIRLEY_NV);
   vec3 h = brdfHalf(wi, wo);
-  float cb = max(dot(wi, h), 1e-7f);
+  float cb = max(brdfHalfCos(wi, wo), 1e-7f);
   // ch^e = exp(e log ch), e log ch = (nu hx^2 + nv hy^2) * 0.5 log(1 - s2) / s2 (finite at h = n).
   float s2 = brdfSin2(h);
   float lobe = exp((nu * h.x * h.x + nv * h.y * h.y) * 0.5f * brdfLog1mOverX(s2));

@@ -16,19 +16,33 @@ SHARED_BEGIN
 // Mirror direction about the normal +z.
 SHARED_FN vec3 brdfReflectZ(vec3 w) { return vec3(-w.x, -w.y, w.z); }
 
-// log(1 - x) for x < 1, accurate for small x (GLSL has no log1p).
+// portableLog(1 - x) for x < 1, accurate to a few ulps on CPU and GPU alike. GLSL has no log1p, and
+// Vulkan allows log/log2 an ABSOLUTE error of 2^-21 for arguments in [0.5, 2] (lavapipe's is of
+// that order): portableLog(0.99) would carry a 3e-5 relative error, which exp(n portableLog(1 - x)) with
+// n = 5000 turns into 0.15 %. So for 1 - x >= 0.5 the logarithm is computed by the series
+// portableLog(1 - x) = -2 atanh(z) = -2 (z + z^3/3 + z^5/5 + ...), z = x / (2 - x) <= 1/3 (11 terms:
+// truncation below 1e-11); below 0.5 the built-in log is accurate (3 ulp).
+SHARED_FN float brdfLog1mSeriesOverX(float x) {  // portableLog(1 - x) / x for |x| <= 0.5
+  float r = 1.0f / (2.0f - x);                   // z = x r
+  float z = x * r;
+  float z2 = z * z;
+  float s = 1.0f + z2 * (1.0f / 3.0f + z2 * (1.0f / 5.0f + z2 * (1.0f / 7.0f + z2 * (1.0f / 9.0f + z2 * (1.0f / 11.0f +
+            z2 * (1.0f / 13.0f + z2 * (1.0f / 15.0f + z2 * (1.0f / 17.0f + z2 * (1.0f / 19.0f + z2 / 21.0f)))))))));
+  return -2.0f * r * s;
+}
+
 SHARED_FN float brdfLog1m(float x) {
-  if (abs(x) < 1e-2f) return -x * (1.0f + x * (0.5f + x * (0.33333333f + x * 0.25f)));
-  return log(max(1.0f - x, 1e-37f));
+  if (abs(x) <= 0.5f) return x * brdfLog1mSeriesOverX(x);
+  return portableLog(max(1.0f - x, 1e-37f));
 }
 
-// log(1 - x) / x (-> -1 as x -> 0), x < 1.
+// portableLog(1 - x) / x (-> -1 as x -> 0), x < 1.
 SHARED_FN float brdfLog1mOverX(float x) {
-  if (abs(x) < 1e-2f) return -(1.0f + x * (0.5f + x * (0.33333333f + x * 0.25f)));
-  return log(max(1.0f - x, 1e-37f)) / x;
+  if (abs(x) <= 0.5f) return brdfLog1mSeriesOverX(x);
+  return portableLog(max(1.0f - x, 1e-37f)) / x;
 }
 
-// (1 - omc)^n for omc = 1 - cos in [0, 1], n >= 0: exp(n log(1 - omc)), with no pow() of values
+// (1 - omc)^n for omc = 1 - cos in [0, 1], n >= 0: exp(n portableLog(1 - omc)), with no pow() of values
 // near 1 (a float cos near 1 has too few bits for n = 20000). Zero for omc >= 1 (cos <= 0).
 SHARED_FN float brdfPowOneMinus(float omc, float n) {
   if (omc >= 1.0f) return 0.0f;
@@ -50,6 +64,11 @@ SHARED_FN float brdfOneMinusCos(vec3 w) { return brdfSin2(w) / (1.0f + max(w.z, 
 // Normalised half vector of two directions above the surface (never zero there).
 SHARED_FN vec3 brdfHalf(vec3 wi, vec3 wo) { return normalize(wi + wo); }
 
+// cos(beta) = wi.h = wo.h, computed as |wi + wo| / 2: symmetric in wi, wo and well conditioned
+// when wi and wo are nearly opposite (dot(wi, h) is not: the unit-length error of float inputs
+// divided by a small |wi + wo| breaks reciprocity by percents at grazing).
+SHARED_FN float brdfHalfCos(vec3 wi, vec3 wo) { return 0.5f * length(wi + wo); }
+
 // Cosine of the relative azimuth of wi and wo; 0 when either lies on the normal.
 SHARED_FN float brdfCosPhi(vec3 wi, vec3 wo) {
   float d = (wi.x * wi.x + wi.y * wi.y) * (wo.x * wo.x + wo.y * wo.y);
@@ -58,7 +77,7 @@ SHARED_FN float brdfCosPhi(vec3 wi, vec3 wo) {
 }
 
 // Polar angle from the cosine, accurate near 0 and 90 degrees.
-SHARED_FN float brdfTheta(float c) { return atan(cosFromSin(c), c); }
+SHARED_FN float brdfTheta(float c) { return portableAtan2(cosFromSin(c), c); }
 
 // Unpolarised Fresnel reflectance for relative complex index eta + i k at incidence cosine c
 // (exact; eta < 1, k = 0 gives total internal reflection = 1). The formulation of
@@ -118,12 +137,12 @@ SHARED_FN float brdfErfc(float x) {
   return x >= 0.0f ? r : 2.0f - r;
 }
 
-// Principal branch of Lambert W for x >= 0 (Halley iterations from log(1 + x); 8 fixed steps
+// Principal branch of Lambert W for x >= 0 (Halley iterations from portableLog(1 + x); 8 fixed steps
 // converge to float precision for x up to 1e30).
 SHARED_FN float brdfLambertW(float x) {
   if (x <= 0.0f) return 0.0f;
-  float w = log(1.0f + x);
-  if (x > 3.0f) w = w - log(max(w, 1e-3f));
+  float w = portableLog(1.0f + x);
+  if (x > 3.0f) w = w - portableLog(max(w, 1e-3f));
   for (int i = 0; i < 8; ++i) {
     float ew = exp(w);
     float f = w * ew - x;

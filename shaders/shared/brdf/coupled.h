@@ -8,7 +8,8 @@
 // cos(89.999 deg), piecewise linear in sqrt(cos theta)) and their cosine-weighted averages
 // Abar1, Abar2 (computed from the interpolants, so the matte term integrates exactly to
 // rd (1 - a_s(theta_i))) live in the parameter block; the registry's packing computes them on the
-// CPU (src/brdf/albedo.cpp, coupledTables). No extra buffer is needed.
+// CPU (src/brdf/albedo.cpp, fillCoupledTables, integrating over the half vector in double
+// precision). No extra buffer is needed; GpuMaterial.info.z stays unused for coupled.
 #ifndef NUSSELT_BRDF_COUPLED_H
 #define NUSSELT_BRDF_COUPLED_H
 #include "common.h"
@@ -27,7 +28,7 @@ SHARED_BEGIN
 SHARED_FN vec3 coupledSpecular(vec3 f0, float m, vec3 wi, vec3 wo) {
   if (wi.z <= 0.0f || wo.z <= 0.0f) return vec3(0.0f);
   vec3 h = brdfHalf(wi, wo);
-  float cb = max(dot(wi, h), 1e-7f);
+  float cb = max(brdfHalfCos(wi, wo), 1e-7f);
   return fresnelSchlick3(cb, f0) * (beckmannD(h, m) / (4.0f * cb * cb));
 }
 

@@ -17,7 +17,9 @@
 #include "oren_nayar.h"
 #include "schlick.h"
 #include "strauss.h"
-//@@MORE_INCLUDES@@
+#include "beard_maxwell.h"
+#include "htsg.h"
+#include "poulin_fournier.h"
 #include "coupled.h"
 #include "mirror.h"
 #include "dielectric.h"
@@ -68,7 +70,9 @@ SHARED_FN vec3 brdfEval(uint model, BrdfParams p, vec3 wi, vec3 wo) {
     case MODEL_OREN_NAYAR: return orenNayarEval(p, wi, wo);
     case MODEL_SCHLICK: return schlickEval(p, wi, wo);
     case MODEL_STRAUSS: return straussEval(p, wi, wo);
-//@@MORE_CASES@@
+    case MODEL_BEARD_MAXWELL: return beardMaxwellEval(p, wi, wo);
+    case MODEL_HTSG: return htsgEval(p, wi, wo);
+    case MODEL_POULIN_FOURNIER: return poulinFournierEval(p, wi, wo);
     case MODEL_COUPLED: return coupledEval(p, wi, wo);
     case MODEL_MIRROR: return mirrorEval(p, wi, wo);
     case MODEL_DIELECTRIC: return dielectricEval(p, wi, wo);

@@ -39,7 +39,7 @@ SHARED_FN vec3 gltfPbrEval(BrdfParams p, vec3 wi, vec3 wo) {
   float rough = brdfParam(p, GLTF_PBR_ROUGHNESS);
   float alpha = max(rough * rough, 1e-3f);
   vec3 h = brdfHalf(wi, wo);
-  float vh = abs(dot(wo, h));
+  float vh = brdfHalfCos(wi, wo);
   vec3 f0 = mix(vec3(0.04f), base, metallic);
   vec3 F = fresnelSchlick3(vh, f0);
   vec3 cdiff = mix(base, vec3(0.0f), metallic);

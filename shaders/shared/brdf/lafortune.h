@@ -21,7 +21,7 @@ SHARED_FN vec3 lafortuneEval(BrdfParams p, vec3 wi, vec3 wo) {
     uint o = LAFORTUNE_LOBES + 4u * uint(j);
     float d = brdfParam(p, o) * wi.x * wo.x + brdfParam(p, o + 1u) * wi.y * wo.y +
               brdfParam(p, o + 2u) * wi.z * wo.z;
-    if (d > 0.0f) sum += exp(brdfParam(p, o + 3u) * log(d));
+    if (d > 0.0f) sum += exp(brdfParam(p, o + 3u) * portableLog(d));
   }
   return brdfParam3(p, LAFORTUNE_RHO_D) * NUSSELT_INV_PI + vec3(sum);
 }

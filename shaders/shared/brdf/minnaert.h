@@ -12,7 +12,7 @@ SHARED_BEGIN
 SHARED_FN vec3 minnaertEval(BrdfParams p, vec3 wi, vec3 wo) {
   if (wi.z <= 0.0f || wo.z <= 0.0f) return vec3(0.0f);
   float k = brdfParam(p, MINNAERT_K);
-  float s = (k + 1.0f) * (0.5f * NUSSELT_INV_PI) * exp((k - 1.0f) * (log(wi.z) + log(wo.z)));
+  float s = (k + 1.0f) * (0.5f * NUSSELT_INV_PI) * exp((k - 1.0f) * (portableLog(wi.z) + portableLog(wo.z)));
   return brdfParam3(p, MINNAERT_RHO) * s;
 }
 

@@ -22,7 +22,7 @@ SHARED_FN vec3 schlickEval(BrdfParams p, vec3 wi, vec3 wo) {
   float pp = brdfParam(p, SCHLICK_P);
   float multiple = brdfParam(p, SCHLICK_MULTIPLE);
   vec3 h = brdfHalf(wi, wo);
-  float u = max(dot(wi, h), 0.0f);
+  float u = brdfHalfCos(wi, wo);
   float v = wi.z;
   float v2 = wo.z;
   // G(v) = v / Dv, Dv = r (1 - v) + v; 1 - G G' = (Dv Dv' - v v') / (Dv Dv') without cancellation.

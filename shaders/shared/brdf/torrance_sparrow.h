@@ -24,7 +24,7 @@ SHARED_FN float vcavityGOver4CiCo(float ci, float co, float ch, float cb) {
 SHARED_FN vec3 torranceSparrowEval(BrdfParams p, vec3 wi, vec3 wo) {
   if (wi.z <= 0.0f || wo.z <= 0.0f) return vec3(0.0f);
   vec3 h = brdfHalf(wi, wo);
-  float cb = max(dot(wi, h), 1e-7f);
+  float cb = max(brdfHalfCos(wi, wo), 1e-7f);
   float F = fresnelComplex(cb, brdfParam(p, TORRANCE_SPARROW_ETA), brdfParam(p, TORRANCE_SPARROW_K));
   float spec = F * beckmannD(h, brdfParam(p, TORRANCE_SPARROW_M)) * vcavityGOver4CiCo(wi.z, wo.z, h.z, cb);
   return brdfParam3(p, TORRANCE_SPARROW_KD) * NUSSELT_INV_PI + brdfParam3(p, TORRANCE_SPARROW_KS) * spec;
