@@ -16,6 +16,7 @@ packages=(
   libopenexr-dev                             # EXR output
   libcli11-dev                               # command-line parsing
   libgtest-dev                               # tests
+  xvfb xauth python3                         # preview tests (an X server; PNG checks)
 )
 missing=()
 for p in "${packages[@]}"; do

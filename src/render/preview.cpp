@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -51,20 +52,20 @@ constexpr std::uint32_t kDisplayReinhard = 2u;
 
 const char* const kKeysHelp =
     "Keys and mouse (any camera change restarts accumulation):\n"
-    "  left drag, arrow keys          orbit around the target\n"
-    "  right/middle drag, Shift+arrows pan\n"
-    "  wheel, PageUp/PageDown, +/-    zoom (dolly; orthographic cameras: magnification)\n"
-    "  R                              reset the camera to the scene's\n"
-    "  [ and ]                        exposure down/up by half a stop; E resets it\n"
-    "  T                              tone map: clamp (as `nusselt render --png`) / Reinhard\n"
-    "  1 2 3 4 5                      sampling strategy: quadtree, cosine, analytic, tabulated,\n"
-    "                                 uniform (today only cosine exists; the others report so)\n"
-    "  Tab                            next available sampling strategy\n"
-    "  L                              lighting estimator: mis -> nee -> bsdf\n"
-    "  Space                          pause/resume accumulation\n"
-    "  S                              save the accumulation: preview-<n>.exr and preview-<n>.png\n"
-    "  H                              print these keys\n"
-    "  Esc, Q, closing the window     quit\n"
+    "  left drag, arrow keys            orbit around the target\n"
+    "  right/middle drag, Shift+arrows  pan\n"
+    "  wheel, PageUp/PageDown, +/-      zoom (dolly; orthographic cameras: magnification)\n"
+    "  R                                reset the camera to the scene's\n"
+    "  [ and ]                          exposure down/up by half a stop; E resets it\n"
+    "  T                                tone map: clamp (as `nusselt render --png`) / Reinhard\n"
+    "  1 2 3 4 5                        sampling strategy: quadtree, cosine, analytic, tabulated,\n"
+    "                                   uniform (today only cosine exists; the others report so)\n"
+    "  Tab                              next available sampling strategy\n"
+    "  L                                lighting estimator: mis -> nee -> bsdf\n"
+    "  Space                            pause/resume accumulation\n"
+    "  S                                save the accumulation: preview-<n>.exr and preview-<n>.png\n"
+    "  H                                print these keys\n"
+    "  Esc, Q, closing the window       quit\n"
     "The title bar shows spp, samples/s, sampler, lighting, exposure and the device.";
 
 // The sampling strategies the keys 1-5 name. RenderSettings has no strategy choice yet (the
@@ -118,9 +119,35 @@ struct PreviewArgs {
   std::string screenshot;
   std::string exr;
   std::vector<std::string> testResize;
+  std::vector<std::string> testKeys;
   bool validation = false;
   bool quiet = false;
 };
+
+// Test harness: a key as written in --test-keys ("S", "2", "Left", "Shift+Up", "]", ...).
+bool parseKeyName(std::string name, int& key, int& mods) {
+  mods = 0;
+  if (name.rfind("Shift+", 0) == 0) {
+    mods = GLFW_MOD_SHIFT;
+    name = name.substr(6);
+  }
+  static const std::pair<const char*, int> named[] = {
+      {"Left", GLFW_KEY_LEFT},       {"Right", GLFW_KEY_RIGHT},         {"Up", GLFW_KEY_UP},
+      {"Down", GLFW_KEY_DOWN},       {"PageUp", GLFW_KEY_PAGE_UP},      {"PageDown", GLFW_KEY_PAGE_DOWN},
+      {"Tab", GLFW_KEY_TAB},         {"Space", GLFW_KEY_SPACE},         {"Esc", GLFW_KEY_ESCAPE},
+      {"[", GLFW_KEY_LEFT_BRACKET},  {"]", GLFW_KEY_RIGHT_BRACKET},     {"+", GLFW_KEY_EQUAL},
+      {"-", GLFW_KEY_MINUS}};
+  for (auto& [n, k] : named)
+    if (name == n) {
+      key = k;
+      return true;
+    }
+  if (name.size() == 1 && std::isalnum(static_cast<unsigned char>(name[0]))) {
+    key = std::toupper(static_cast<unsigned char>(name[0]));  // GLFW_KEY_A.. and GLFW_KEY_0.. are ASCII
+    return true;
+  }
+  return false;
+}
 
 LightingMode parseLighting(const std::string& s) {
   return s == "nee" ? LightingMode::NeeOnly : s == "bsdf" ? LightingMode::BsdfOnly : LightingMode::Mis;
@@ -224,7 +251,7 @@ class Preview {
 
  private:
   void createRenderer(std::uint32_t width, std::uint32_t height);
-  void createSwapchain();
+  bool createSwapchain();  // false: the surface has no area (minimised); try later
   void destroySwapchain();
   bool presentFrame();  // false: the swapchain must be recreated
   void updateTitle(bool force);
@@ -399,7 +426,7 @@ void Preview::createRenderer(std::uint32_t width, std::uint32_t height) {
   m_displayDirty = true;
 }
 
-void Preview::createSwapchain() {
+bool Preview::createSwapchain() {
   VkSurfaceCapabilitiesKHR caps;
   VK_CHECK(vkGetPhysicalDeviceSurfaceCapabilitiesKHR(m_ctx.physical, m_surface, &caps));
   VkExtent2D extent = caps.currentExtent;
@@ -407,7 +434,7 @@ void Preview::createSwapchain() {
     extent.width = std::clamp<std::uint32_t>(std::uint32_t(m_fbWidth), caps.minImageExtent.width, caps.maxImageExtent.width);
     extent.height = std::clamp<std::uint32_t>(std::uint32_t(m_fbHeight), caps.minImageExtent.height, caps.maxImageExtent.height);
   }
-  if (extent.width == 0 || extent.height == 0) return;  // minimised: try again later
+  if (extent.width == 0 || extent.height == 0) return false;  // minimised: try again later
   if (!(caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_DST_BIT))
     throw Error("the window surface does not accept transfers into its images (VK_IMAGE_USAGE_TRANSFER_DST_BIT), "
                 "which the preview needs");
@@ -474,6 +501,7 @@ void Preview::createSwapchain() {
   if (!m_renderer || m_settings.width != extent.width || m_settings.height != extent.height)
     createRenderer(extent.width, extent.height);
   m_displayDirty = true;
+  return true;
 }
 
 void Preview::destroySwapchain() {
@@ -666,6 +694,12 @@ int Preview::run() {
     if (!(in >> w >> x >> h) || x != 'x' || w < 1 || h < 1) throw Error("--test-resize " + s + ": expected WxH");
     resizes.push_back({w, h});
   }
+  std::vector<std::pair<int, int>> keys;
+  for (const std::string& k : a.testKeys) {
+    int key = 0, mods = 0;
+    if (!parseKeyName(k, key, mods)) throw Error("--test-keys " + k + ": unknown key");
+    keys.push_back({key, mods});
+  }
   srgbDecodeTable();
 
   // A display first: without one there is nothing to do, whatever the scene.
@@ -755,11 +789,21 @@ int Preview::run() {
   g_stopSignal = 0;
   auto oldInt = std::signal(SIGINT, onSignal);
   auto oldTerm = std::signal(SIGTERM, onSignal);
-  std::size_t nextResize = 0;
+  std::size_t nextResize = 0, nextKey = 0;
   bool swapchainStale = false;
   while (!glfwWindowShouldClose(m_window) && g_stopSignal == 0) {
-    const bool idle = m_paused || (a.maxSpp && m_renderer->samplesDone() >= a.maxSpp && !m_cameraDirty && !m_lightingDirty);
+    bool idle = m_paused || (a.maxSpp && m_renderer->samplesDone() >= a.maxSpp && !m_cameraDirty && !m_lightingDirty);
+    // Test harness: one key per frame from the second frame on, as if typed (also while idle).
+    if (nextKey < keys.size() && (idle || m_framesPresented >= 1 + nextKey)) {
+      onKey(keys[nextKey].first, keys[nextKey].second);
+      ++nextKey;
+      continue;
+    }
     const bool minimised = glfwGetWindowAttrib(m_window, GLFW_ICONIFIED) != 0;
+    // Scripts: once --max-spp is reached nothing changes any more, so --frames ends the run.
+    if (a.frames && a.maxSpp && m_renderer->samplesDone() >= a.maxSpp && !m_cameraDirty && !m_lightingDirty &&
+        !m_displayDirty && nextKey >= keys.size())
+      break;
     if (minimised || (idle && !m_displayDirty && !swapchainStale)) {
       glfwWaitEventsTimeout(0.25);  // nothing to draw: sleep until something happens
       updateTitle(false);
@@ -786,8 +830,8 @@ int Preview::run() {
       m_fbWidth = fbw;
       m_fbHeight = fbh;
       vkDeviceWaitIdle(m_ctx.device);
-      createSwapchain();
-      if (!m_swapchain || m_extent.width == 0) {
+      if (!createSwapchain()) {
+        swapchainStale = true;
         glfwWaitEventsTimeout(0.25);
         continue;
       }
@@ -891,13 +935,15 @@ void registerPreviewCommand(CLI::App& app, CommandRunner& run) {
   p->add_option("--tonemap", a->tonemap, "Display tone map at start (T switches): clamp (as `render --png`), reinhard")
       ->capture_default_str()->check(CLI::IsMember({"clamp", "reinhard"}));
   p->add_option("--device", a->device, "Vulkan device index (see `nusselt devices`)");
-  p->add_option("--frames", a->frames, "Exit after presenting this many frames (scripts and tests; 0: run until closed)")
+  p->add_option("--frames", a->frames, "Exit after presenting this many frames, or earlier when --max-spp is reached (scripts and tests; 0: run until closed)")
       ->capture_default_str();
   p->add_option("--max-spp", a->maxSpp, "Stop accumulating at this many samples per pixel and idle (0: no limit)")
       ->capture_default_str();
   p->add_option("--screenshot", a->screenshot, "At exit, write the last presented frame (8-bit sRGB) as PNG");
   p->add_option("--exr", a->exr, "At exit, write the accumulated film (32-bit float, as `render -o`) as OpenEXR");
   p->add_option("--test-resize", a->testResize, "Test harness: resize the window to WxH during the run (repeatable)")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)->delimiter(',')->group("");  // hidden
+  p->add_option("--test-keys", a->testKeys, "Test harness: keys to press, one per frame (e.g. S,L,2,Shift+Left)")
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)->delimiter(',')->group("");  // hidden
   p->add_flag("--validation", a->validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the preview");
   p->add_flag("-q,--quiet", a->quiet, "No summary output");
