@@ -18,15 +18,24 @@ uint queueCount(uint queue) { return g.queues.v[queue]; }
 
 uint queueItem(uint queue, uint i) { return g.queues.v[QUEUE_HEADER_UINTS + queue * g.frame.w + i]; }
 
-// Push a path id. One atomic per subgroup (lavapipe: halves the cost of a per-lane atomic).
+// Push a path id. Lanes of a subgroup may push to different queues (intersect sends each hit
+// to its model's shade queue): the lanes pushing to the same queue as the first remaining lane
+// take one atomic together, then the others repeat (at most one round per distinct queue; one
+// atomic per subgroup and queue instead of one per lane, which halves the cost on lavapipe).
 void queuePush(uint queue, uint path) {
-  uvec4 ballot = subgroupBallot(true);
-  uint n = subgroupBallotBitCount(ballot);
-  uint rank = subgroupBallotExclusiveBitCount(ballot);
-  uint base = 0u;
-  if (subgroupElect()) base = atomicAdd(g.queues.v[queue], n);
-  base = subgroupBroadcastFirst(base);
-  g.queues.v[QUEUE_HEADER_UINTS + queue * g.frame.w + base + rank] = path;
+  for (int round = 0; round < 128; ++round) {
+    uint leader = subgroupBroadcastFirst(queue);
+    if (leader == queue) {
+      uvec4 ballot = subgroupBallot(true);
+      uint n = subgroupBallotBitCount(ballot);
+      uint rank = subgroupBallotExclusiveBitCount(ballot);
+      uint base = 0u;
+      if (subgroupElect()) base = atomicAdd(g.queues.v[queue], n);
+      base = subgroupBroadcastFirst(base);
+      g.queues.v[QUEUE_HEADER_UINTS + queue * g.frame.w + base + rank] = path;
+      return;
+    }
+  }
 }
 
 // ---- Rays -----------------------------------------------------------------------------------

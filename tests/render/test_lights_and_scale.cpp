@@ -162,3 +162,51 @@ TEST(LargeScene, TrianglesBeyondOneStorageBufferBindingStillRender) {
     ASSERT_NEAR(a.rgb[i], b.rgb[i], 1e-4f * std::max(1.0f, a.rgb[i])) << "value " << i;
   EXPECT_EQ(test::validationMessages(), 0u);
 }
+
+TEST(ShadeQueues, EachHitIsShadedByItsOwnModel) {
+  // A checkerboard floor of two models (lambert rho 0.2 and minnaert rho 0.8 with k = 1, which
+  // is Lambertian too) under a directional light, direct lighting only: every pixel inside a
+  // tile has the exact value of its tile. Hits of one subgroup go to different shade queues; if
+  // a path were queued for the wrong model's stage, its pixel would take the other value.
+  // 11 tiles across 64 pixels: tile edges fall inside subgroups of 8 consecutive pixels.
+  const int tiles = 11;
+  Scene s = floorScene(tiles);
+  Material m2;
+  m2.name = "minnaert";
+  m2.model = MODEL_MINNAERT;
+  m2.params = packParams(*findModel("minnaert"), {{"rho", ParamValue::num(0.8)}, {"k", ParamValue::num(1.0)}}, "test");
+  s.materials[0].params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(0.2)}}, "test");
+  s.materials.push_back(m2);
+  for (std::size_t t = 0; t < s.triangleMaterial.size(); ++t) {
+    int quad = int(t / 2), i = quad % tiles, j = quad / tiles;
+    s.triangleMaterial[t] = (i + j) % 2;
+  }
+  PunctualLight l;
+  l.type = LightType::Directional;
+  l.direction = glm::normalize(glm::vec3(0.2f, 0.1f, -1.0f));
+  l.intensity = glm::vec3(1.0f);
+  s.lights.push_back(l);
+  RenderSettings rs = directOnly();
+  rs.width = rs.height = 64;
+  rs.spp = 4;
+  test::Rendered r = test::render(s, rs);
+  const float cosT = -l.direction.z;
+  int checked = 0, wrong = 0;
+  for (int y = 0; y < rs.height; ++y)
+    for (int x = 0; x < rs.width; ++x) {
+      // Tile of each pixel corner (image rows go down, the floor's y goes up); skip pixels that
+      // straddle a tile edge.
+      auto tileX = [&](double px) { return int(std::floor(px * tiles / rs.width)); };
+      int i = tileX(x + 0.001), j = tiles - 1 - tileX(y + 0.001);
+      if (tileX(x + 0.999) != i || tiles - 1 - tileX(y + 0.999) != j) continue;
+      float rho = (i + j) % 2 == 0 ? 0.2f : 0.8f;
+      float expected = rho / float(M_PI) * cosT;
+      float got = r.image.rgb[3 * (y * rs.width + x)];
+      ++checked;
+      if (std::fabs(got - expected) > 1e-5f * expected) ++wrong;
+    }
+  EXPECT_GT(checked, 2500);
+  EXPECT_EQ(wrong, 0) << "of " << checked << " pixels";
+  EXPECT_EQ(r.stats.nonFiniteSamples, 0u);
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
