@@ -478,6 +478,46 @@ int diffCommand(const std::string& a, const std::string& b) {
   return kExitOk;
 }
 
+// Pipeline creation and first-dispatch compile time for a one-model scene and a scene with
+// every model: a render compiles only the shade stages its scene uses.
+int benchPipelinesCommand(int device) {
+  // Mesa's on-disk shader cache would hide the compile cost after the first run.
+  const bool cacheWasSet = std::getenv("MESA_SHADER_CACHE_DISABLE") != nullptr;
+  if (!cacheWasSet) setenv("MESA_SHADER_CACHE_DISABLE", "true", 1);
+  vk::Context ctx;
+  vk::ContextOptions co;
+  co.deviceIndex = device;
+  vk::createContext(ctx, co);
+  std::printf("device: %s; Mesa shader cache %s\n", ctx.deviceName.c_str(),
+              cacheWasSet ? "as set by MESA_SHADER_CACHE_DISABLE" : "disabled for this measurement");
+  std::printf("%-34s %7s %14s %16s %12s\n", "scene", "models", "pipelines (s)", "first pass (s)", "next pass (s)");
+  std::string materials = std::string(NUSSELT_SCENES_DIR) + "/materials/materials.gltf";
+  for (const std::string& path : {std::string(), materials}) {
+    if (!path.empty() && !std::filesystem::exists(path)) {
+      std::printf("%s not found\n", path.c_str());
+      continue;
+    }
+    Scene scene = loadSceneOrDefault(path, "");
+    RenderSettings s;
+    s.width = s.height = 32;
+    s.maxDepth = 2;
+    auto t0 = std::chrono::steady_clock::now();
+    Renderer r(ctx, scene, s);
+    double create = r.summary().pipelineSeconds;
+    auto t1 = std::chrono::steady_clock::now();
+    r.renderPass();
+    auto t2 = std::chrono::steady_clock::now();
+    r.renderPass();
+    auto t3 = std::chrono::steady_clock::now();
+    (void)t0;
+    std::printf("%-34s %7zu %14.3f %16.3f %12.3f\n", path.empty() ? "default (cornell-box)" : "materials (one sphere per model)",
+                r.summary().models.size(), create, std::chrono::duration<double>(t2 - t1).count(),
+                std::chrono::duration<double>(t3 - t2).count());
+  }
+  vk::destroyContext(ctx);
+  return kExitOk;
+}
+
 struct AlbedoArgs {
   std::string model;
   std::vector<std::string> params;
@@ -578,6 +618,11 @@ int runCli(int argc, char** argv) {
   albedo->add_option("--phi", aa.phi, "Azimuth of the incident direction, degrees (anisotropic models)")->capture_default_str();
   albedo->get_option("--param")->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
 
+  int pipelinesDevice = -1;
+  CLI::App* benchPipelines = bench->add_subcommand("pipelines", "Pipeline creation and first-dispatch compile time: a one-model "
+                                                                "scene against the scene with all 20 models");
+  benchPipelines->add_option("--device", pipelinesDevice, "Vulkan device index");
+
   std::vector<std::string> mergeInputs;
   std::string mergeOutput;
   CLI::App* merge = app.add_subcommand("merge", "Combine partial renders of disjoint sample ranges (--spp-offset) into one");
@@ -607,6 +652,7 @@ int runCli(int argc, char** argv) {
     if (*render) return renderCommand(ra);
     if (*devices) return devicesCommand();
     if (*benchRender) return benchRenderCommand(ba);
+    if (*benchPipelines) return benchPipelinesCommand(pipelinesDevice);
     if (*info) return infoCommand(infoFiles);
     if (*merge) return mergeCommand(mergeInputs, mergeOutput);
     if (*albedo) return albedoCommand(aa);

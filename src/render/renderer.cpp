@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <thread>
 
 #include "scene/bvh.h"
 #include "util/error.h"
@@ -380,8 +381,25 @@ void Renderer::createPipelines() {
   m_intersect = vk::createComputePipeline(m_ctx, m_pipelineLayout, "intersect");
   m_shadow = vk::createComputePipeline(m_ctx, m_pipelineLayout, "shadow");
   m_accumulate = vk::createComputePipeline(m_ctx, m_pipelineLayout, "accumulate");
-  // Only the models this scene uses: one specialised shade pipeline each.
-  for (std::uint32_t model : m_slotModels) m_shade.push_back(vk::createComputePipeline(m_ctx, m_pipelineLayout, "shade", {model}));
+  // Only the models this scene uses: one specialised shade pipeline each, created on all cores
+  // (drivers compile at creation; lavapipe takes ~0.3 s per shade pipeline, single-threaded).
+  m_shade.resize(m_slotModels.size());
+  std::vector<std::thread> workers;
+  std::vector<std::string> errors(m_slotModels.size());
+  const unsigned threads = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), unsigned(m_slotModels.size())));
+  for (unsigned t = 0; t < threads; ++t)
+    workers.emplace_back([&, t] {
+      for (std::size_t s = t; s < m_slotModels.size(); s += threads) {
+        try {
+          m_shade[s] = vk::createComputePipeline(m_ctx, m_pipelineLayout, "shade", {m_slotModels[s]});
+        } catch (const std::exception& e) {
+          errors[s] = e.what();
+        }
+      }
+    });
+  for (auto& w : workers) w.join();
+  for (const std::string& e : errors)
+    if (!e.empty()) throw Error(e);
 }
 
 void Renderer::dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst,
