@@ -85,6 +85,7 @@ struct RenderArgs {
   bool validation = false;
   bool quiet = false;
   float exposure = 0.0f;
+  double checkpointSeconds = 120;
 };
 
 // What a render records in its EXR header (and what --resume and merge check and carry on).
@@ -95,6 +96,7 @@ struct RenderRecord {
   RenderSettings settings;
   std::uint32_t spp = 0;
   bool interrupted = false;
+  bool checkpoint = false;  // written during the render (periodic checkpoint), not at its end
   RenderStats stats;
   std::uint64_t droppedTriangles = 0;
   double renderSeconds = 0;
@@ -121,6 +123,7 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
                {"nusselt/seed", r.settings.seed},
                {"nusselt/maxDepth", r.settings.maxDepth},
                {"nusselt/interrupted", r.interrupted ? 1 : 0},
+               {"nusselt/checkpoint", r.checkpoint ? 1 : 0},
                {"nusselt/rays", static_cast<std::int64_t>(r.stats.rays)},
                {"nusselt/shadowRays", static_cast<std::int64_t>(r.stats.shadowRays)},
                {"nusselt/nonFiniteSamples", static_cast<std::int64_t>(r.stats.nonFiniteSamples)},
@@ -258,12 +261,49 @@ int renderCommand(const RenderArgs& a) {
     }
 
     auto tRender = std::chrono::steady_clock::now();
+    // What the header says about this render at any moment (checkpoints and the final image).
+    auto record = [&](bool checkpoint) {
+      RenderRecord r;
+      r.scene = scene.sourcePath;
+      r.device = ctx.deviceName;
+      r.models = models;
+      r.settings = s;
+      r.spp = renderer.samplesDone();
+      r.interrupted = g_stopSignal != 0;
+      r.checkpoint = checkpoint;
+      r.stats = renderer.stats();
+      r.droppedTriangles = scene.droppedTriangles;
+      double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - tRender).count();
+      r.renderSeconds = previous.renderSeconds + now;
+      r.totalSeconds = previous.totalSeconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      return r;
+    };
+    std::uint32_t checkpointSpp = 0;
     {
       Progress progress("render", s.spp, std::uint64_t(s.width) * s.height, false, a.quiet);
       progress.update(renderer.samplesDone());
-      while (renderer.samplesDone() < s.spp && g_stopSignal == 0) {
-        renderer.renderPass();
-        progress.update(renderer.samplesDone());
+      auto lastCheckpoint = std::chrono::steady_clock::now();
+      try {
+        while (renderer.samplesDone() < s.spp && g_stopSignal == 0) {
+          renderer.renderPass();
+          progress.update(renderer.samplesDone());
+          // A periodic checkpoint: the output file always holds a resumable image, so a crash,
+          // a power cut or a lost device loses at most one interval of work.
+          if (a.checkpointSeconds > 0 && renderer.samplesDone() < s.spp &&
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - lastCheckpoint).count() >= a.checkpointSeconds) {
+            writeExr(output, renderer.image(a.variance), makeMetadata(record(true)));
+            checkpointSpp = renderer.samplesDone();
+            lastCheckpoint = std::chrono::steady_clock::now();
+          }
+        }
+      } catch (const Error& e) {
+        // The device was lost or ran out of memory mid-render: its film cannot be read any more.
+        std::string saved = checkpointSpp > 0
+                                ? "; the last checkpoint (" + std::to_string(checkpointSpp) + " spp) is in " + output +
+                                      ": continue with --resume " + output
+                                : previous.spp > 0 ? "; " + a.resume + " still holds its " + std::to_string(previous.spp) + " spp"
+                                                   : "; no checkpoint had been written yet (see --checkpoint)";
+        throw Error(std::string(e.what()) + " after " + std::to_string(renderer.samplesDone()) + " spp" + saved);
       }
       double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - tRender).count();
       RenderStats st = renderer.stats();
@@ -272,18 +312,7 @@ int renderCommand(const RenderArgs& a) {
                     (st.rays + st.shadowRays - previous.stats.rays - previous.stats.shadowRays) / 1e6 / std::max(1e-9, sec));
       progress.finish(extra);
     }
-    RenderRecord rec;
-    rec.scene = scene.sourcePath;
-    rec.device = ctx.deviceName;
-    rec.models = models;
-    rec.settings = s;
-    rec.spp = renderer.samplesDone();
-    rec.interrupted = g_stopSignal != 0;
-    rec.stats = renderer.stats();
-    rec.droppedTriangles = scene.droppedTriangles;
-    rec.renderSeconds = previous.renderSeconds +
-                        std::chrono::duration<double>(std::chrono::steady_clock::now() - tRender).count();
-    rec.totalSeconds = previous.totalSeconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    RenderRecord rec = record(false);
     if (rec.interrupted)
       std::fprintf(stderr, "interrupted by %s after %u of %u spp: writing what has accumulated\n",
                    g_stopSignal == SIGINT ? "SIGINT" : "SIGTERM", rec.spp, s.spp);
@@ -557,6 +586,9 @@ int albedoCommand(const AlbedoArgs& a) {
 }  // namespace
 
 int runCli(int argc, char** argv) {
+  // A file-size limit (ulimit -f) makes write() fail with EFBIG, reported like a full disk,
+  // instead of killing the process with SIGXFSZ before it can say anything.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"nusselt: a physically based renderer with generic BRDF sampling on Vulkan compute"};
   app.set_version_flag("--version", NUSSELT_VERSION);
   app.require_subcommand(1);
@@ -590,6 +622,9 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
   render->add_option("--rng", ra.rng, "Random numbers: pcg (independent hashes) or qmc (padded Owen-scrambled Sobol)")
       ->capture_default_str()->check(CLI::IsMember({"pcg", "qmc"}));
+  render->add_option("--checkpoint", ra.checkpointSeconds, "Write the image so far to the output every this many seconds "
+                                                          "(resumable with --resume; 0: never)")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e9));
   render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
   render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
   render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <thread>
 
@@ -473,6 +474,10 @@ void Renderer::recordPass(VkCommandBuffer cmd, std::uint32_t chunkStart, std::ui
 }
 
 void Renderer::renderPass() {
+  // Fault injection for the tests of device loss (no GPU can be lost on purpose):
+  // NUSSELT_FAULT_DEVICE_LOST_AFTER=N makes the pass after N samples fail as a lost device would.
+  static const char* fault = std::getenv("NUSSELT_FAULT_DEVICE_LOST_AFTER");
+  if (fault && m_samples >= std::strtoul(fault, nullptr, 10)) VK_CHECK(VK_ERROR_DEVICE_LOST);
   const std::uint64_t pixels = std::uint64_t(m_settings.width) * m_settings.height;
   for (std::uint64_t start = 0; start < pixels; start += m_capacity) {
     std::uint32_t count = static_cast<std::uint32_t>(std::min<std::uint64_t>(m_capacity, pixels - start));

@@ -65,5 +65,49 @@ else
   grep -q overlap "$work/err" && [ ! -e "$work/bad.exr" ] && echo "ok   overlapping ranges refused" || fail "overlap message: $(cat "$work/err")"
 fi
 
+# A crash (SIGKILL: no handler runs) loses at most one checkpoint interval: the output holds a
+# resumable image.
+"$nusselt" render "${common[@]}" --spp 1000000 --checkpoint 1 -o "$work/crash.exr" &
+pid=$!
+sleep 4
+kill -KILL $pid
+wait $pid 2>/dev/null
+k=$("$nusselt" info "$work/crash.exr" 2>/dev/null | sed -n 's/^  nusselt\/spp: //p')
+if [ -n "$k" ] && [ "$k" -ge 1 ] && [ "$("$nusselt" info "$work/crash.exr" | sed -n 's/^  nusselt\/checkpoint: //p')" = 1 ]; then
+  "$nusselt" render "${common[@]}" --spp $((k + 2)) --resume "$work/crash.exr" || fail "resume after a crash"
+  "$nusselt" render "${common[@]}" --spp $((k + 2)) -o "$work/crash_ref.exr" || fail "reference render"
+  [ "$(maxdiff "$work/crash.exr" "$work/crash_ref.exr")" = 0 ] && echo "ok   killed at checkpoint $k spp, resumed: identical" ||
+    fail "resumed-after-crash differs"
+else
+  fail "no checkpoint after a crash (spp '$k')"
+fi
+
+# A lost device: a clear error naming the last checkpoint, non-zero exit, and the checkpoint
+# resumes (fault injection: the device "is lost" after 1500 samples, checkpoints every 0.2 s).
+if NUSSELT_FAULT_DEVICE_LOST_AFTER=1500 "$nusselt" render "${common[@]}" --spp 3000 --checkpoint 0.2 -o "$work/lost.exr" 2>"$work/err"; then
+  fail "device loss not reported"
+else
+  k=$("$nusselt" info "$work/lost.exr" 2>/dev/null | sed -n 's/^  nusselt\/spp: //p')
+  if grep -q "VK_ERROR_DEVICE_LOST" "$work/err" && grep -q -- "--resume" "$work/err" && [ -n "$k" ] && [ "$k" -le 1500 ]; then
+    echo "ok   device lost: $(cat "$work/err")"
+    "$nusselt" render "${common[@]}" --spp 1600 --resume "$work/lost.exr" || fail "resume after device loss"
+  else
+    fail "device loss message or checkpoint: $(cat "$work/err") (checkpoint spp '$k')"
+  fi
+fi
+
+# A full disk (here a file-size limit: write() fails with EFBIG) gives a clear error, a
+# non-zero exit, and the previous file intact.
+cp "$work/full.exr" "$work/keep2.exr"
+if (ulimit -f 1; "$nusselt" render "${common[@]}" --spp 2 -o "$work/full.exr" 2>"$work/err"); then
+  fail "write beyond the file-size limit succeeded"
+else
+  if grep -q "full.exr" "$work/err" && cmp -s "$work/full.exr" "$work/keep2.exr" && ! ls "$work"/.*tmp* >/dev/null 2>&1; then
+    echo "ok   full disk: $(cat "$work/err")"
+  else
+    fail "full disk: $(cat "$work/err")"
+  fi
+fi
+
 [ $fails -eq 0 ] && echo "resume and merge checks pass"
 exit $((fails > 0))
