@@ -4,28 +4,46 @@
 // towards the viewer (wo.z > 0), wi towards the light; pdf is per unit solid angle, 0 for a
 // delta (specular) sample; weight = f(wi, wo) cos(theta_i) / pdf (rgb), or the delta lobe's
 // reflectance/transmittance for delta samples; continuation = probability of continuing the
-// random walk after this sample (Russian roulette), see below.
+// random walk after this sample (Russian roulette).
 // Failure: returns false (no direction, zero pdf) and the path ends.
 //
-// Non-delta models: cosine sampling of the projected disc, exact for lambert and unbiased for
-// all (its pdf is positive wherever f can be); the quadtree sampler of the generic-sampling paper
-// replaces it per model without touching the stages. Delta models (mirror, dielectric) are
-// sampled analytically.
+// Strategies for non-delta models (SAMPLER_*, a specialization constant of the shade stage):
+//   quadtree  the generic sampler of Montes et al. (quadtree.h): density proportional to
+//             f cos, for any model; continuation = the tabulated directional albedo
+//   cosine    cosine-weighted hemisphere (the random-walk source's diffuse sampling)
+//   uniform   uniform hemisphere
+// All return the true density of their samples, so all are unbiased. Delta models (mirror,
+// dielectric) are always sampled analytically.
 #ifndef NUSSELT_BSDF_SAMPLING_H
 #define NUSSELT_BSDF_SAMPLING_H
 #include "brdf/dispatch.h"
+#include "quadtree.h"
 #include "warp.h"
 SHARED_BEGIN
 
-SHARED_FN float bsdfPdf(uint model, BrdfParams p, vec3 wo, vec3 wi) {
-  if (wo.z <= 0.0f || modelIsDelta(model)) return 0.0f;
+#define SAMPLER_QUADTREE 0u
+#define SAMPLER_COSINE 1u
+#define SAMPLER_UNIFORM 2u
+
+// The quadtree sampler needs the material's QuadSet; without one it falls back to cosine.
+SHARED_FN uint effectiveSampler(uint strategy, uint quadSet) {
+  return (strategy == SAMPLER_QUADTREE && quadSet == INVALID_INDEX) ? SAMPLER_COSINE : strategy;
+}
+
+SHARED_FN float bsdfPdf(uint strategy, uint model, uint quadSet, BrdfParams p, vec3 wo, vec3 wi) {
+  if (wo.z <= 0.0f || wi.z <= 0.0f || modelIsDelta(model)) return 0.0f;
+  uint s = effectiveSampler(strategy, quadSet);
+  if (s == SAMPLER_QUADTREE) return quadPdf(quadSet, model, p, wo, wi);
+  if (s == SAMPLER_UNIFORM) return 0.5f * NUSSELT_INV_PI;
   return cosineHemispherePdf(wi);
 }
 
 // inside: the path arrived from the inside (the back side of the surface's front face), which
 // matters for refraction only: the dielectric's relative index is then 1/eta.
-SHARED_FN bool bsdfSample(uint model, BrdfParams p, vec3 wo, bool inside, vec2 u, OUT(vec3) wi, OUT(vec3) weight,
-                          OUT(float) pdf, OUT(float) continuation) {
+// rngKey = (pixel, sample index, dimension, seed) of the draw: the quadtree's rejection loop
+// takes its further numbers from its own stream of that key.
+SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p, vec3 wo, bool inside, vec2 u,
+                          uvec4 rngKey, OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(float) continuation) {
   wi = vec3(0.0f, 0.0f, 1.0f);
   weight = vec3(0.0f);
   pdf = 0.0f;
@@ -43,29 +61,42 @@ SHARED_FN bool bsdfSample(uint model, BrdfParams p, vec3 wo, bool inside, vec2 u
     float eta = brdfParam(p, DIELECTRIC_ETA);
     float etaRel = inside ? 1.0f / eta : eta;  // n(wi side) / n(wo side) for transmission
     float R = fresnelDielectric(wo.z, etaRel);
-    if (u.x < R) {
+    vec3 t;
+    if (u.x < R || !dielectricRefract(etaRel, wo, t)) {
       wi = brdfReflectZ(wo);
       weight = vec3(1.0f);
     } else {
-      vec3 t;
-      if (!dielectricRefract(etaRel, wo, t)) {  // cannot happen when R < 1, kept for safety
-        wi = brdfReflectZ(wo);
-        weight = vec3(1.0f);
-      } else {
-        wi = t;
-        weight = vec3(1.0f / (etaRel * etaRel));
-      }
+      wi = t;
+      weight = vec3(1.0f / (etaRel * etaRel));
     }
     // The walk does not end at a lossless interface: the radiance scaling is not an albedo.
     continuation = 1.0f;
     return true;
   }
-  wi = squareToCosineHemisphere(u);
-  pdf = cosineHemispherePdf(wi);
-  if (pdf <= 0.0f) return false;
+  uint s = effectiveSampler(strategy, quadSet);
+  if (s == SAMPLER_QUADTREE) {
+    vec3 f;
+    if (!quadSample(quadSet, model, p, wo, u, rngKey, wi, pdf, f) || !(pdf > 0.0f)) return false;
+    weight = f * (wi.z / pdf);
+    // The random-walk source's roulette: continue with the tabulated directional albedo. With
+    // sampling proportional to f cos the weight's luminance is that albedo, so surviving paths
+    // of a grey BRDF carry weight 1.
+    continuation = min(1.0f, quadAlbedo(quadSet, wo.z, portableAtan2(wo.y, wo.x)));
+    return true;
+  }
+  if (s == SAMPLER_UNIFORM) {
+    float z = u.x;
+    float r = cosFromSin(z);
+    float phi = NUSSELT_TWO_PI * u.y;
+    wi = vec3(r * cos(phi), r * sin(phi), z);
+    pdf = 0.5f * NUSSELT_INV_PI;
+  } else {
+    wi = squareToCosineHemisphere(u);
+    pdf = cosineHemispherePdf(wi);
+  }
+  if (!(pdf > 0.0f) || wi.z <= 0.0f) return false;
   weight = brdfEval(model, p, wi, wo) * (wi.z / pdf);
-  // With sampling proportional to f cos, the weight is the directional albedo: continuing with
-  // probability equal to it is the random-walk source's albedo roulette.
+  // Without a tabulated albedo, the sample weight's luminance (its estimate) is the continuation.
   continuation = min(1.0f, luminance(weight));
   return true;
 }

@@ -22,22 +22,43 @@ struct QuadNode {
 };
 STATIC_ASSERT_SIZE(QuadNode, 32);
 
-// data = (M: upper bound of f over the leaf, mass: integral of f over the leaf,
-//         proposal kind (QT_PROPOSAL_*), proposal parameter)
-#define QT_PROPOSAL_UNIFORM 0u  // uniform point in the leaf, accept with f / M
+// data = (M: upper bound of f (QT_PROPOSAL_UNIFORM) or of f cos^s (QT_PROPOSAL_RIM) over the
+//         leaf, mass: integral of f over the leaf and the disc, proposal kind (QT_PROPOSAL_*, as a
+//         float), proposal parameter s);
+// box = rim proposal only: the polar box of (leaf square & disc): (cos theta at its inner
+//       radius, first azimuth, azimuth width, 0).
+#define QT_PROPOSAL_UNIFORM 0u  // uniform point in the leaf square, accept with f / M
+// Leaves cut by the rim: the proposal is the polar box of (square & disc), r in [r_a, 1],
+// phi in [phi_a, phi_a + dphi], with disc density ~ cos^-s (uniform in cos^(2-s) and phi; s = 0
+// for models bounded on the disc, s > 0 for f ~ cos^-s at the horizon: ward92 1/2, duer 1,
+// minnaert 1-k, schlick (multiple) 1, beard_maxwell 1); points outside the square are rejected;
+// accept with f cos^s / M, M bounding f cos^s (finite at the rim). Tight for rim slivers.
+#define QT_PROPOSAL_RIM 1u
 struct QuadLeaf {
   vec4 data;
+  vec4 box;
 };
-STATIC_ASSERT_SIZE(QuadLeaf, 16);
+STATIC_ASSERT_SIZE(QuadLeaf, 32);
 
-// info = (root node or QT_LEAF_BIT | leaf, 0, 0, 0); data = (total mass = directional albedo of
-// the luminance of f, cos theta of the table's fixed direction, phi of it, 0)
+// info = (root node or QT_LEAF_BIT | leaf, bits of cos phi, bits of sin phi, 0);
+// data = (total mass = directional albedo of the luminance of f, cos theta of the table's fixed
+// direction, phi of it, sin theta). The fixed direction is quadTableDirection(): the builder and
+// the sampler use the same float vector.
 struct QuadTable {
   uvec4 info;
   vec4 data;
 };
 STATIC_ASSERT_SIZE(QuadTable, 32);
 
+// Set flags: anisotropic sets tabulate phi in [0, 90 deg] and use the mirror symmetries x -> -x,
+// y -> -y (applied to both directions); isotropic sets rotate the known direction to phi = 0.
+#define QT_SET_ANISOTROPIC 1u
+// Trial cap of the in-leaf rejection loop (lavapipe truncates loops silently: every loop is
+// bounded). With acceptance >= 1/n_max = 1/2 a failure has probability 2^-256.
+#define QT_MAX_TRIALS 256u
+// Bound of the tree descent loop (the builder's depth cap is far below).
+#define QT_MAX_DESCENT 32u
+// Tables of a set: table(k_theta, j_phi) = first + k_theta * phiTables + j_phi.
 // info = (first table, tables along theta, tables along phi (1: isotropic), flags);
 // data = (defensive cosine fraction epsilon, theta step (radians), phi step (radians), 0)
 struct QuadSet {

@@ -8,6 +8,7 @@
 #include "shared/bsdf_sampling.h"
 
 layout(constant_id = 0) const uint MODEL_ID = 0u;
+layout(constant_id = 1) const uint SAMPLER = SAMPLER_QUADTREE;
 
 void main() {
   uint idx = gl_GlobalInvocationID.x;
@@ -79,7 +80,7 @@ void main() {
       float cosS = max(wiL.z, 0.0f);
       vec3 c = beta * f * cosS * ls.value;
       if (ls.pdf > 0.0f && lighting == LIGHTING_MIS)
-        c *= powerHeuristic(ls.pdf, bsdfPdf(MODEL_ID, M.params, wo, wiL));
+        c *= powerHeuristic(ls.pdf, bsdfPdf(SAMPLER, MODEL_ID, M.info.z, M.params, wo, wiL));
       if (max(c.x, max(c.y, c.z)) > 0.0f) {
         // Stop short of the light so that the emitter itself never occludes.
         float tmax = ls.dist < 1.0e38f ? ls.dist * (1.0f - 1e-4f) : ls.dist;
@@ -95,12 +96,15 @@ void main() {
   if (last) return;
 
   // ---- BSDF sampling: the next step of the random walk ----
-  vec2 uB = sample2(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_BSDF), seed);
+  uint dimB = rngDimension(bounce, RNG_DIM_BSDF);
+  vec2 uB = sample2(rngMode, pixel, sampleIndex, dimB, seed);
   vec3 wiLocal;
   vec3 weight;
   float pdf;
   float q;
-  if (!bsdfSample(MODEL_ID, M.params, wo, !frontFace, uB, wiLocal, weight, pdf, q)) return;
+  if (!bsdfSample(SAMPLER, MODEL_ID, M.info.z, M.params, wo, !frontFace, uB, uvec4(pixel, sampleIndex, dimB, seed),
+                  wiLocal, weight, pdf, q))
+    return;
   vec3 wi = toWorld(wiLocal, tt, bb, ns);
   // Reflection must stay above the geometric surface (else light leaks through it); refraction
   // (only delta models transmit) must cross it, and leaves from the other side.

@@ -81,6 +81,7 @@ struct RenderArgs {
   int device = -1;
   std::string lighting = "mis";
   std::string rng = "pcg";
+  std::string sampler = "quadtree";
   bool variance = false;
   bool validation = false;
   bool quiet = false;
@@ -116,7 +117,7 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
                                          "albedo Russian roulette"},
                   {"nusselt/lighting", lightingModeName(r.settings.lighting)},
                   {"nusselt/rng", rngModeName(r.settings.rng)},
-                  {"nusselt/sampler", "cosine"},
+                  {"nusselt/sampler", samplerName(r.settings.sampler)},
                   {"nusselt/models", r.models}};
   meta.ints = {{"nusselt/spp", r.spp},
                {"nusselt/sppOffset", r.settings.sampleOffset},
@@ -154,6 +155,8 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   std::string lighting = str("nusselt/lighting");
   r.settings.lighting = parseLighting(lighting);
   r.settings.rng = findString(meta, "nusselt/rng").value_or("pcg") == "qmc" ? RngMode::Qmc : RngMode::Pcg;
+  if (!parseSampler(str("nusselt/sampler"), r.settings.sampler))
+    throw Error(path + ": header attribute nusselt/sampler names an unknown sampler");
   r.spp = static_cast<std::uint32_t>(num("nusselt/spp"));
   r.settings.sampleOffset = static_cast<std::uint32_t>(num("nusselt/sppOffset"));
   r.settings.seed = static_cast<std::uint32_t>(num("nusselt/seed"));
@@ -199,6 +202,7 @@ int renderCommand(const RenderArgs& a) {
   s.sampleOffset = a.sppOffset;
   s.lighting = parseLighting(a.lighting);
   s.rng = a.rng == "qmc" ? RngMode::Qmc : RngMode::Pcg;
+  parseSampler(a.sampler, s.sampler);
   // Image size: defaults follow the camera's aspect ratio when only one side (or none) is given.
   float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
   s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u);
@@ -223,6 +227,7 @@ int renderCommand(const RenderArgs& a) {
     mismatch("--max-depth", std::to_string(previous.settings.maxDepth), std::to_string(s.maxDepth));
     mismatch("--lighting", lightingModeName(previous.settings.lighting), lightingModeName(s.lighting));
     mismatch("--rng", rngModeName(previous.settings.rng), rngModeName(s.rng));
+    mismatch("--sampler", samplerName(previous.settings.sampler), samplerName(s.sampler));
     mismatch("--spp-offset", std::to_string(previous.settings.sampleOffset), std::to_string(s.sampleOffset));
     if (saved.sum.empty() || saved.sumSq.empty())
       throw Error("--resume " + a.resume + ": no accumulation channels (sum.R/G/B, sumSq.R/G/B)");
@@ -254,10 +259,14 @@ int renderCommand(const RenderArgs& a) {
       std::fprintf(stderr, "scene: %s: %zu triangles, %zu materials (models: %s), %zu lights; BVH %u nodes in %.3f s\n",
                    scene.sourcePath.c_str(), sum.triangles, sum.materials, models.c_str(), sum.lights, sum.bvhNodes,
                    sum.bvhSeconds);
-      std::fprintf(stderr, "device: %s; %ux%u, %u spp%s, max depth %u, seed %u, lighting %s, rng %s\n",
+      if (sum.samplerTrees)
+        std::fprintf(stderr, "sampler: %u quadtrees (%.1f MiB) in %.2f s (cache: %u hits, %u built, %u rejected)\n",
+                     sum.samplerTrees, sum.samplerBytes / 1048576.0, sum.samplerSeconds, sum.samplerCacheHits,
+                     sum.samplerCacheMisses, sum.samplerCacheRejected);
+      std::fprintf(stderr, "device: %s; %ux%u, %u spp%s, max depth %u, seed %u, lighting %s, rng %s, sampler %s\n",
                    ctx.deviceName.c_str(), s.width, s.height, s.spp,
                    a.resume.empty() ? "" : (" (resuming from " + std::to_string(previous.spp) + ")").c_str(),
-                   s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng));
+                   s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng), samplerName(s.sampler));
     }
 
     auto tRender = std::chrono::steady_clock::now();
@@ -376,6 +385,7 @@ int mergeCommand(const std::vector<std::string>& inputs, const std::string& outp
       same("the max depth", std::to_string(merged.settings.maxDepth), std::to_string(r.settings.maxDepth));
       same("the lighting", lightingModeName(merged.settings.lighting), lightingModeName(r.settings.lighting));
       same("the random numbers", rngModeName(merged.settings.rng), rngModeName(r.settings.rng));
+      same("the sampler", samplerName(merged.settings.sampler), samplerName(r.settings.sampler));
       for (std::size_t i = 0; i < total.sum.size(); ++i) {
         total.sum[i] += img.sum[i];
         total.sumSq[i] += img.sumSq[i];
@@ -620,6 +630,9 @@ int runCli(int argc, char** argv) {
   render->add_option("--spp-offset", ra.sppOffset, "First sample index of this render: split a frame across machines "
                                                    "into disjoint ranges and combine them with `nusselt merge`")
       ->capture_default_str();
+  render->add_option("--sampler", ra.sampler, "BSDF sampling of non-delta models: quadtree (the generic sampler: "
+                                              "density proportional to BRDF x cos for any model), cosine, uniform")
+      ->capture_default_str()->check(CLI::IsMember({"quadtree", "cosine", "uniform"}));
   render->add_option("--rng", ra.rng, "Random numbers: pcg (independent hashes) or qmc (padded Owen-scrambled Sobol)")
       ->capture_default_str()->check(CLI::IsMember({"pcg", "qmc"}));
   render->add_option("--checkpoint", ra.checkpointSeconds, "Write the image so far to the output every this many seconds "

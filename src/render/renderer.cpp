@@ -8,6 +8,7 @@
 #include <cstring>
 #include <thread>
 
+#include "quadtree/sampler_tables.h"
 #include "scene/bvh.h"
 #include "util/error.h"
 
@@ -29,6 +30,24 @@ const char* lightingModeName(LightingMode mode) {
     case LightingMode::BsdfOnly: return "bsdf";
   }
   return "?";
+}
+
+const char* samplerName(SamplerKind kind) {
+  switch (kind) {
+    case SamplerKind::Quadtree: return "quadtree";
+    case SamplerKind::Cosine: return "cosine";
+    case SamplerKind::Uniform: return "uniform";
+  }
+  return "?";
+}
+
+bool parseSampler(const std::string& name, SamplerKind& kind) {
+  for (SamplerKind k : {SamplerKind::Quadtree, SamplerKind::Cosine, SamplerKind::Uniform})
+    if (name == samplerName(k)) {
+      kind = k;
+      return true;
+    }
+  return false;
 }
 
 const char* rngModeName(RngMode mode) { return mode == RngMode::Qmc ? "qmc" : "pcg"; }
@@ -249,7 +268,8 @@ void Renderer::uploadScene(const Scene& scene) {
   g.bvh = make(nodes.size() * sizeof(BvhNode), "BVH", nodes.data())->address;
   g.triangles = make(tris.size() * sizeof(GpuTriangle), "triangle", tris.data())->address;
   g.shading = make(shading.size() * sizeof(GpuTriShading), "triangle shading", shading.data())->address;
-  g.materials = make(materials.size() * sizeof(GpuMaterial), "material", materials.data())->address;
+  vk::Buffer* materialBuffer = make(materials.size() * sizeof(GpuMaterial), "material", materials.data());
+  g.materials = materialBuffer->address;
   g.lights = make(lights.size() * sizeof(GpuLight), "light", lights.data())->address;
   g.lightCdf = make(cdf.size() * sizeof(float), "light CDF", cdf.data())->address;
   m_film = make(pixels * 16, "film");
@@ -273,11 +293,36 @@ void Renderer::uploadScene(const Scene& scene) {
   m_stats = make(STAT_COUNT * 4, "statistics", nullptr, 0, true);
   std::memset(m_stats->mapped, 0, STAT_COUNT * 4);
   g.stats = m_stats->address;
-  // Generic-sampler tables: none yet (every model is cosine sampled until the quadtrees land).
-  g.quadSets = make(sizeof(shared::QuadSet), "quadtree sets")->address;
-  g.quadTables = make(sizeof(shared::QuadTable), "quadtree tables")->address;
-  g.quadNodes = make(sizeof(shared::QuadNode), "quadtree nodes")->address;
-  g.quadLeaves = make(sizeof(shared::QuadLeaf), "quadtree leaves")->address;
+  // ---- The generic sampler's quadtrees: only for the non-delta materials the scene uses ----
+  std::vector<std::pair<std::uint32_t, shared::BrdfParams>> toBuild;
+  std::vector<std::size_t> builtMaterial;
+  if (m_settings.sampler == SamplerKind::Quadtree)
+    for (std::size_t i = 0; i < scene.materials.size(); ++i)
+      if (materialUsed[i] && !modelById(scene.materials[i].model).delta) {
+        toBuild.push_back({scene.materials[i].model, scene.materials[i].params});
+        builtMaterial.push_back(i);
+      }
+  quadtree::SamplerTables qt;
+  if (!toBuild.empty()) {
+    std::vector<std::uint32_t> setOf;
+    qt = quadtree::buildSamplerTables(toBuild, quadtree::QuadtreeSettings{}, setOf);
+    for (std::size_t k = 0; k < builtMaterial.size(); ++k) materials[builtMaterial[k]].info.z = setOf[k];
+    m_summary.samplerSeconds = qt.seconds;
+    m_summary.samplerTrees = static_cast<std::uint32_t>(qt.tables.size());
+    m_summary.samplerBytes = qt.bytes();
+    m_summary.samplerCacheHits = qt.cacheHits;
+    m_summary.samplerCacheMisses = qt.cacheMisses;
+    m_summary.samplerCacheRejected = qt.cacheRejected;
+    vk::uploadBuffer(m_ctx, *materialBuffer, materials.data(), materials.size() * sizeof(GpuMaterial));
+  }
+  auto orOne = [](auto& v) {
+    if (v.empty()) v.resize(1);
+    return v.size();
+  };
+  g.quadSets = make(orOne(qt.sets) * sizeof(shared::QuadSet), "quadtree sets", qt.sets.data())->address;
+  g.quadTables = make(orOne(qt.tables) * sizeof(shared::QuadTable), "quadtree tables", qt.tables.data())->address;
+  g.quadNodes = make(orOne(qt.nodes) * sizeof(shared::QuadNode), "quadtree nodes", qt.nodes.data())->address;
+  g.quadLeaves = make(orOne(qt.leaves) * sizeof(shared::QuadLeaf), "quadtree leaves", qt.leaves.data())->address;
   g.display = 0;
 
   // Film starts at zero.
@@ -392,7 +437,8 @@ void Renderer::createPipelines() {
     workers.emplace_back([&, t] {
       for (std::size_t s = t; s < m_slotModels.size(); s += threads) {
         try {
-          m_shade[s] = vk::createComputePipeline(m_ctx, m_pipelineLayout, "shade", {m_slotModels[s]});
+          m_shade[s] = vk::createComputePipeline(m_ctx, m_pipelineLayout, "shade",
+                                                 {m_slotModels[s], static_cast<std::uint32_t>(m_settings.sampler)});
         } catch (const std::exception& e) {
           errors[s] = e.what();
         }

@@ -15,6 +15,12 @@ namespace nusselt {
 
 enum class LightingMode : std::uint32_t { Mis = 0, NeeOnly = 1, BsdfOnly = 2 };
 const char* lightingModeName(LightingMode mode);
+// BSDF sampling strategy for non-delta models (SAMPLER_* in shaders/shared/bsdf_sampling.h).
+enum class SamplerKind : std::uint32_t { Quadtree = 0, Cosine = 1, Uniform = 2 };
+const char* samplerName(SamplerKind kind);
+// nullptr-safe parse: returns false for an unknown name.
+bool parseSampler(const std::string& name, SamplerKind& kind);
+
 // Random numbers: independent PCG hashes, or padded Owen-scrambled Sobol (quasi-Monte Carlo).
 enum class RngMode : std::uint32_t { Pcg = 0, Qmc = 1 };
 const char* rngModeName(RngMode mode);
@@ -27,6 +33,7 @@ struct RenderSettings {
   std::uint32_t seed = 0;
   LightingMode lighting = LightingMode::Mis;
   RngMode rng = RngMode::Pcg;
+  SamplerKind sampler = SamplerKind::Quadtree;  // the generic sampler of Montes et al.
   // Sample indices of this render start here (`--spp-offset`): a frame can be split across
   // machines into disjoint sample ranges and merged (`nusselt merge`).
   std::uint32_t sampleOffset = 0;
@@ -53,6 +60,10 @@ struct SceneSummary {
   double bvhSeconds = 0;
   std::uint32_t bvhNodes = 0;
   double pipelineSeconds = 0;       // creating the pipelines (lavapipe compiles at first dispatch)
+  double samplerSeconds = 0;        // building (or loading) the quadtrees
+  std::uint32_t samplerTrees = 0;
+  std::uint64_t samplerBytes = 0;
+  std::uint32_t samplerCacheHits = 0, samplerCacheMisses = 0, samplerCacheRejected = 0;
   std::uint64_t deviceBytes = 0;
 };
 

@@ -1,0 +1,309 @@
+// quadtree.h: the generic BRDF sampler of Montes, Urena, Garcia and Lastra (GRAPP 2008), shared by
+// the CPU (tests, `nusselt sample --cpu`) and the GPU (shade stages, sample_tool).
+//
+// Domain: the unit disc (x, y) = (sin t cos p, sin t sin p) of the upper hemisphere; a density
+// proportional to f on the disc is proportional to f cos(theta) per unit solid angle.
+// One tree per tabulated known direction v_k; it samples w with disc density f(w, v_k) / a_k,
+// a_k = integral of f(., v_k) over the disc (the directional albedo of the luminance of f).
+// Convention: brdfEval(model, p, w, v): the sampled direction is the FIRST argument (wi, towards
+// the light) and the known direction the second (wo, towards the viewer). docs/sampler.md.
+//
+// Buffer access: GLSL reads the buffer references of the Globals `g`; C++ reads host arrays
+// through the thread-local QuadHost pointer that the CPU sampler sets (QuadHostScope in
+// src/quadtree/sampler_tables.h). The sampling logic exists once.
+#ifndef NUSSELT_QUADTREE_H
+#define NUSSELT_QUADTREE_H
+#include "brdf/dispatch.h"
+#include "rng.h"
+#include "warp.h"
+
+#ifdef __cplusplus
+SHARED_BEGIN
+struct QuadHost {
+  const QuadSet* sets = nullptr;
+  const QuadTable* tables = nullptr;
+  const QuadNode* nodes = nullptr;
+  const QuadLeaf* leaves = nullptr;
+  std::uint64_t boundViolations = 0;  // samples during which f > M was seen in their leaf
+  std::uint64_t trialFailures = 0;    // samples that hit QT_MAX_TRIALS (returned false)
+  std::uint64_t trials = 0;           // total rejection trials (statistics)
+  std::uint64_t samples = 0;          // calls of quadSample that reached a leaf
+};
+inline thread_local QuadHost* g_quadHost = nullptr;
+SHARED_END
+#define QT_SET(i) (::nusselt::shared::g_quadHost->sets[i])
+#define QT_TABLE(i) (::nusselt::shared::g_quadHost->tables[i])
+#define QT_NODE(i) (::nusselt::shared::g_quadHost->nodes[i])
+#define QT_LEAF(i) (::nusselt::shared::g_quadHost->leaves[i])
+#define QT_COUNT_BOUND_VIOLATION() (::nusselt::shared::g_quadHost->boundViolations++)
+#define QT_COUNT_TRIAL_FAILURE() (::nusselt::shared::g_quadHost->trialFailures++)
+#define QT_COUNT_TRIALS(n) (::nusselt::shared::g_quadHost->trials += (n), ::nusselt::shared::g_quadHost->samples++)
+#else
+#define QT_SET(i) (g.quadSets.v[i])
+#define QT_TABLE(i) (g.quadTables.v[i])
+#define QT_NODE(i) (g.quadNodes.v[i])
+#define QT_LEAF(i) (g.quadLeaves.v[i])
+#define QT_COUNT_BOUND_VIOLATION() atomicAdd(g.stats.v[STAT_SAMPLER_BOUND_VIOLATIONS], 1u)
+#define QT_COUNT_TRIAL_FAILURE() atomicAdd(g.stats.v[STAT_SAMPLER_TRIAL_FAILURES], 1u)
+#define QT_COUNT_TRIALS(n)
+#endif
+
+SHARED_BEGIN
+
+// Angles within this fraction of a table step snap to the table (float error of the caller's
+// direction): no defensive term there, so the weight f cos / pdf is exactly the table's albedo.
+#define QT_SNAP 1e-3f
+
+// ---- Tables -------------------------------------------------------------------------------------
+
+// The known direction of a table (canonical frame), the same float vector in builder and sampler.
+SHARED_FN vec3 quadTableDirection(QuadTable T) {
+  float cp = uintBitsToFloat(T.info.y);
+  float sp = uintBitsToFloat(T.info.z);
+  return vec3(T.data.w * cp, T.data.w * sp, T.data.y);
+}
+
+// Canonical frame of a known direction v: isotropic sets rotate v to azimuth 0
+// (frame = (cos phi_v, sin phi_v, 1, 1)); anisotropic sets reflect it into the first quadrant
+// (frame = (1, 0, sign x, sign y)). toCanonical(w) = R(-phi) S w; fromCanonical = S R(phi).
+SHARED_FN vec4 quadFrame(bool aniso, vec3 v) {
+  if (aniso) return vec4(1.0f, 0.0f, v.x < 0.0f ? -1.0f : 1.0f, v.y < 0.0f ? -1.0f : 1.0f);
+  float s2 = v.x * v.x + v.y * v.y;
+  if (s2 < 1e-30f) return vec4(1.0f, 0.0f, 1.0f, 1.0f);
+  float inv = inversesqrt(s2);
+  return vec4(v.x * inv, v.y * inv, 1.0f, 1.0f);
+}
+SHARED_FN vec3 quadToCanonical(vec4 fr, vec3 w) {
+  float x = fr.z * w.x;
+  float y = fr.w * w.y;
+  return vec3(fr.x * x + fr.y * y, -fr.y * x + fr.x * y, w.z);
+}
+SHARED_FN vec3 quadFromCanonical(vec4 fr, vec3 w) {
+  float x = fr.x * w.x - fr.y * w.y;
+  float y = fr.y * w.x + fr.x * w.y;
+  return vec3(fr.z * x, fr.w * y, w.z);
+}
+
+// Position of the (canonical) known direction in the table grid: tables k0, k1 along theta with
+// weight t of k1, j0, j1 along phi with weight s of j1; returns whether it sits on a table
+// (within QT_SNAP of a step in both coordinates: then t = s = 0).
+SHARED_FN bool quadGrid(QuadSet S, vec3 vc, OUT(uvec4) idx, OUT(vec2) ts) {
+  uint nt = S.info.y;
+  uint np = S.info.z;
+  float sinT = sqrt(vc.x * vc.x + vc.y * vc.y);
+  float theta = atan(sinT, max(vc.z, 0.0f));
+  float ft = theta / S.data.y;
+  float kf = min(floor(ft), float(nt - 1u));
+  float t = clamp(ft - kf, 0.0f, 1.0f);
+  bool exact = true;
+  if (t < QT_SNAP) t = 0.0f;
+  else if (t > 1.0f - QT_SNAP && kf + 1.0f < float(nt)) { kf += 1.0f; t = 0.0f; }
+  else exact = false;
+  uint k0 = uint(kf);
+  uint k1 = min(k0 + 1u, nt - 1u);
+  uint j0 = 0u;
+  uint j1 = 0u;
+  float s = 0.0f;
+  if (np > 1u && sinT > 0.0f) {
+    float phi = atan(abs(vc.y), abs(vc.x));
+    float fp = phi / S.data.z;
+    float jf = min(floor(fp), float(np - 1u));
+    s = clamp(fp - jf, 0.0f, 1.0f);
+    if (s < QT_SNAP) s = 0.0f;
+    else if (s > 1.0f - QT_SNAP && jf + 1.0f < float(np)) { jf += 1.0f; s = 0.0f; }
+    else exact = false;
+    j0 = uint(jf);
+    j1 = min(j0 + 1u, np - 1u);
+  }
+  if (k0 == nt - 1u && ft > kf + QT_SNAP) exact = false;  // beyond the last table
+  idx = uvec4(k0, k1, j0, j1);
+  ts = vec2(t, s);
+  return exact;
+}
+
+// Luminance of f(w, v) (the density the trees are built on).
+SHARED_FN float quadEvalLum(uint model, BrdfParams p, vec3 w, vec3 v) {
+  float f = luminance(brdfEval(model, p, w, v));
+  return isFinite(f) ? max(f, 0.0f) : 0.0f;
+}
+
+// Solid-angle density of the mixture at the canonical direction wc (wc.z > 0): the (bi)linear
+// mixture of the neighbouring trees, plus eps cos / pi when the direction is between tables.
+SHARED_FN float quadMixturePdf(QuadSet S, uint model, BrdfParams p, uvec4 idx, vec2 ts, float eps, vec3 wc) {
+  if (wc.z <= 0.0f) return 0.0f;
+  uint np = S.info.z;
+  float sum = 0.0f;
+  for (uint c = 0u; c < 4u; ++c) {
+    float wt = ((c & 1u) != 0u ? ts.x : 1.0f - ts.x) * ((c & 2u) != 0u ? ts.y : 1.0f - ts.y);
+    if (wt <= 0.0f) continue;
+    uint k = (c & 1u) != 0u ? idx.y : idx.x;
+    uint j = (c & 2u) != 0u ? idx.w : idx.z;
+    QuadTable T = QT_TABLE(S.info.x + k * np + j);
+    if (T.data.x <= 0.0f) continue;
+    sum += wt * quadEvalLum(model, p, wc, quadTableDirection(T)) / T.data.x;
+  }
+  return (1.0f - eps) * sum * wc.z + eps * wc.z * NUSSELT_INV_PI;
+}
+
+// ---- Public interface ---------------------------------------------------------------------------
+
+// Density per unit solid angle with which quadSample draws w for the known direction v (both in
+// the local frame, normal +z). 0 below the surface. For MIS; no tree descent.
+SHARED_FN float quadPdf(uint set, uint model, BrdfParams p, vec3 v, vec3 w) {
+  if (v.z <= 0.0f || w.z <= 0.0f) return 0.0f;
+  QuadSet S = QT_SET(set);
+  vec4 fr = quadFrame((S.info.w & QT_SET_ANISOTROPIC) != 0u, v);
+  uvec4 idx;
+  vec2 ts;
+  bool exact = quadGrid(S, quadToCanonical(fr, v), idx, ts);
+  return quadMixturePdf(S, model, p, idx, ts, exact ? 0.0f : S.data.x, quadToCanonical(fr, w));
+}
+
+// Tabulated directional albedo (luminance) at polar angle acos(cosTheta) and azimuth phi of the
+// known direction, interpolated (bi)linearly between tables: the Russian-roulette continuation
+// probability of the random-walk source.
+SHARED_FN float quadAlbedo(uint set, float cosTheta, float phi) {
+  QuadSet S = QT_SET(set);
+  float c = clamp(cosTheta, 0.0f, 1.0f);
+  vec3 v = vec3(cosFromSin(c) * cos(phi), cosFromSin(c) * sin(phi), c);
+  vec4 fr = quadFrame((S.info.w & QT_SET_ANISOTROPIC) != 0u, v);
+  uvec4 idx;
+  vec2 ts;
+  quadGrid(S, quadToCanonical(fr, v), idx, ts);
+  uint np = S.info.z;
+  float a00 = QT_TABLE(S.info.x + idx.x * np + idx.z).data.x;
+  float a10 = QT_TABLE(S.info.x + idx.y * np + idx.z).data.x;
+  float a01 = QT_TABLE(S.info.x + idx.x * np + idx.w).data.x;
+  float a11 = QT_TABLE(S.info.x + idx.y * np + idx.w).data.x;
+  return mix(mix(a00, a10, ts.x), mix(a01, a11, ts.x), ts.y);
+}
+
+// Draws w for the known direction v (local frame, v.z > 0) with density quadPdf (returned in
+// pdf, per unit solid angle) and returns f = brdfEval(model, p, w, v) (rgb). u: two uniform
+// numbers (component choice and tree descent); rngKey = (pixel, sample, dimension, seed) of the
+// caller: the in-leaf rejection draws from (pixel, sample, RNG_REJECTION_STREAM | trial << 16 |
+// dimension, seed). Returns false (w = 0, pdf = 0, f = 0) when v is below the surface, the table
+// has no mass, or QT_MAX_TRIALS trials were all rejected (counted as a trial failure).
+// Samples that saw f > M in their leaf are counted as bound violations.
+SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, uvec4 rngKey, OUT(vec3) w,
+                          OUT(float) pdf, OUT(vec3) f) {
+  w = vec3(0.0f);
+  pdf = 0.0f;
+  f = vec3(0.0f);
+  if (v.z <= 0.0f) return false;
+  QuadSet S = QT_SET(set);
+  vec4 fr = quadFrame((S.info.w & QT_SET_ANISOTROPIC) != 0u, v);
+  uvec4 idx;
+  vec2 ts;
+  bool exact = quadGrid(S, quadToCanonical(fr, v), idx, ts);
+  float eps = exact ? 0.0f : S.data.x;
+  uint np = S.info.z;
+  vec3 wc = vec3(0.0f);
+
+  // ---- Component: defensive cosine (probability eps) or one of the neighbouring trees ----
+  float uy = u.y;
+  if (uy < eps) {
+    wc = squareToCosineHemisphere(vec2(u.x, min(uy / eps, NUSSELT_ONE_MINUS_EPS)));
+  } else {
+    uy = (uy - eps) / (1.0f - eps);
+    uint k = idx.x;
+    if (uy >= 1.0f - ts.x) { k = idx.y; uy = (uy - (1.0f - ts.x)) / ts.x; }
+    else uy = uy / (1.0f - ts.x);
+    uint j = idx.z;
+    if (uy >= 1.0f - ts.y) j = idx.w;
+    QuadTable T = QT_TABLE(S.info.x + k * np + j);
+    vec3 vk = quadTableDirection(T);
+    if (T.data.x <= 0.0f) return false;
+
+    // ---- Leaf: descend with one uniform number, rescaled at each level ----
+    float x0 = -1.0f, x1 = 1.0f, y0 = -1.0f, y1 = 1.0f;
+    float ux = u.x;
+    uint link = T.info.x;
+    for (uint d = 0u; d < QT_MAX_DESCENT; ++d) {
+      if ((link & QT_LEAF_BIT) != 0u) break;
+      QuadNode N = QT_NODE(link);
+      float m0 = N.mass.x, m1 = N.mass.y, m2 = N.mass.z, m3 = N.mass.w;
+      float t = ux * (m0 + m1 + m2 + m3);
+      uint c = 0u;
+      float below = 0.0f;
+      if (t >= m0) { c = 1u; below = m0; }
+      if (t >= m0 + m1) { c = 2u; below = m0 + m1; }
+      if (t >= m0 + m1 + m2) { c = 3u; below = m0 + m1 + m2; }
+      if (N.mass[c] <= 0.0f) {  // rounding at a boundary: the last child with mass
+        c = m3 > 0.0f ? 3u : (m2 > 0.0f ? 2u : (m1 > 0.0f ? 1u : 0u));
+        below = t - 0.5f * N.mass[c];
+      }
+      ux = clamp((t - below) / N.mass[c], 0.0f, NUSSELT_ONE_MINUS_EPS);
+      float xm = 0.5f * (x0 + x1);
+      float ym = 0.5f * (y0 + y1);
+      if ((c & 1u) != 0u) x0 = xm; else x1 = xm;
+      if ((c & 2u) != 0u) y0 = ym; else y1 = ym;
+      link = N.child[c];
+    }
+    if ((link & QT_LEAF_BIT) == 0u || link == QT_EMPTY) return false;
+    QuadLeaf L = QT_LEAF(link & ~QT_LEAF_BIT);
+    float M = L.data.x;
+    bool rim = L.data.z > 0.5f;
+    float s = L.data.w;
+
+    // Polar box of (leaf & disc) (rim proposal): cos theta in [0, coA], phi in [pa, pa + dp].
+    float coA = L.box.x;
+    float pa = L.box.y;
+    float dp = L.box.z;
+
+    // ---- Rejection in the same leaf (restarting at the root would break proportionality) ----
+    bool accepted = false;
+    bool violated = false;
+    uint trial = 0u;
+    float fl = 0.0f;
+    for (; trial < QT_MAX_TRIALS; ++trial) {
+      uvec4 h = pcg4d(uvec4(rngKey.x, rngKey.y, (rngKey.z & 0xffffu) | RNG_REJECTION_STREAM | (trial << 16u), rngKey.w));
+      float a = float(h.x >> 8u) * (1.0f / 16777216.0f);
+      float b = float(h.y >> 8u) * (1.0f / 16777216.0f);
+      float cc = float(h.z >> 8u) * (1.0f / 16777216.0f);
+      float x, y, co, weight;
+      if (rim) {
+        co = coA * pow(a, 1.0f / (2.0f - s));
+        float r = cosFromSin(co);
+        float ph = pa + b * dp;
+        x = r * cos(ph);
+        y = r * sin(ph);
+        if (x < x0 || x > x1 || y < y0 || y > y1) continue;
+        weight = pow(co, s);
+      } else {
+        x = mix(x0, x1, a);
+        y = mix(y0, y1, b);
+        float r2 = x * x + y * y;
+        if (r2 >= 1.0f) continue;
+        co = cosFromSin(sqrt(r2));
+        weight = 1.0f;
+      }
+      if (co <= 0.0f) continue;
+      wc = vec3(x, y, co);
+      fl = quadEvalLum(model, p, wc, vk);
+      float g = fl * weight;
+      if (g > M) violated = true;
+      if (cc * M < g) { accepted = true; break; }
+    }
+    QT_COUNT_TRIALS(trial + 1u);
+    if (violated) QT_COUNT_BOUND_VIOLATION();
+    if (!accepted) {
+      QT_COUNT_TRIAL_FAILURE();
+      return false;
+    }
+    if (eps == 0.0f && ts.x == 0.0f && ts.y == 0.0f) {
+      // On a table: one component, pdf = f(w, v_k) cos / a_k with the f already evaluated.
+      w = quadFromCanonical(fr, wc);
+      pdf = fl * wc.z / T.data.x;
+      f = brdfEval(model, p, w, v);
+      return pdf > 0.0f;
+    }
+  }
+  w = quadFromCanonical(fr, wc);
+  pdf = quadMixturePdf(S, model, p, idx, ts, eps, wc);
+  f = brdfEval(model, p, w, v);
+  return pdf > 0.0f;
+}
+
+SHARED_END
+#endif

@@ -1,0 +1,33 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_scalar_block_layout : require
+// sample_tool: draws directions with the generic (quadtree) sampler for `nusselt sample` and the
+// GPU tests. MODEL_ID is a specialization constant (one model per pipeline, as in shade).
+// Inputs in Globals: image.x = samples in this dispatch, image.y = index of the first one,
+// frame.y = seed, camForward.xyz = the known direction v (local frame), materials.v[0] = the
+// material (info.z = its QuadSet). Outputs per sample i: film.v[i] = (w, pdf or 0 on failure),
+// filmSq.v[i] = (f rgb, 1 if the sample succeeded). Counters: stats (bound violations, trial
+// failures). Sample i uses rng2(i, 0, RNG_DIM_BSDF, seed) and the rejection stream of
+// (i, 0, RNG_DIM_BSDF, seed): the CPU reproduces it bit for bit up to float differences.
+#include "shared/layout.h"
+#include "shared/quadtree.h"
+
+layout(local_size_x = WORKGROUP_SIZE) in;
+layout(constant_id = 0) const uint MODEL_ID = 0u;
+
+void main() {
+  uint local = gl_GlobalInvocationID.x;
+  if (local >= g.image.x) return;
+  uint i = g.image.y + local;
+  GpuMaterial M = g.materials.v[0];
+  vec3 v = g.camForward.xyz;
+  uint seed = g.frame.y;
+  vec2 u = rng2(i, 0u, RNG_DIM_BSDF, seed);
+  vec3 w;
+  float pdf;
+  vec3 f;
+  bool ok = quadSample(M.info.z, MODEL_ID, M.params, v, u, uvec4(i, 0u, RNG_DIM_BSDF, seed), w, pdf, f);
+  g.film.v[i] = vec4(w, ok ? pdf : 0.0f);
+  g.filmSq.v[i] = vec4(f, ok ? 1.0f : 0.0f);
+}

@@ -1,0 +1,153 @@
+// sample_run.cpp: see sample_run.h.
+#include "quadtree/sample_run.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include "../../shaders/shared/layout.h"
+
+namespace nusselt::quadtree {
+
+using namespace shared;
+
+SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint32_t model, const BrdfParams& params, vec3 v,
+                      std::uint32_t n, std::uint32_t seed, unsigned threads) {
+  auto t0 = std::chrono::steady_clock::now();
+  SampleBatch out;
+  out.wPdf.assign(n, vec4(0.0f));
+  out.fOk.assign(n, vec4(0.0f));
+  unsigned nt = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
+  std::atomic<std::uint64_t> viol{0}, fail{0}, trials{0};
+  auto work = [&](unsigned t) {
+    QuadHostScope scope(tables);
+    for (std::uint32_t i = t; i < n; i += nt) {
+      vec2 u = rng2(i, 0u, RNG_DIM_BSDF, seed);
+      vec3 w, f;
+      float pdf;
+      bool ok = quadSample(set, model, params, v, u, uvec4(i, 0u, RNG_DIM_BSDF, seed), w, pdf, f);
+      out.wPdf[i] = vec4(w, ok ? pdf : 0.0f);
+      out.fOk[i] = vec4(f, ok ? 1.0f : 0.0f);
+    }
+    viol += scope.counters().boundViolations;
+    fail += scope.counters().trialFailures;
+    trials += scope.counters().trials;
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < nt; ++t) pool.emplace_back(work, t);
+  work(0);
+  for (auto& th : pool) th.join();
+  out.boundViolations = viol;
+  out.trialFailures = fail;
+  out.trials = trials;
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32_t set, std::uint32_t model,
+                      const BrdfParams& params, vec3 v, std::uint32_t n, std::uint32_t seed) {
+  SampleBatch out;
+  VkDevice d = ctx.device;
+  auto upload = [&](const void* data, std::size_t bytes, const char* what) {
+    vk::Buffer b = vk::createBuffer(ctx, std::max<std::size_t>(bytes, 16), 0, false, what);
+    if (bytes) vk::uploadBuffer(ctx, b, data, bytes);
+    return b;
+  };
+  GpuMaterial mat{};
+  mat.info = uvec4(model, 0u, set, 0u);
+  mat.params = params;
+  vk::Buffer materials = upload(&mat, sizeof mat, "sampler materials");
+  vk::Buffer sets = upload(tables.sets.data(), tables.sets.size() * sizeof(QuadSet), "quadtree sets");
+  vk::Buffer tabs = upload(tables.tables.data(), tables.tables.size() * sizeof(QuadTable), "quadtree tables");
+  vk::Buffer nodes = upload(tables.nodes.data(), tables.nodes.size() * sizeof(QuadNode), "quadtree nodes");
+  vk::Buffer leaves = upload(tables.leaves.data(), tables.leaves.size() * sizeof(QuadLeaf), "quadtree leaves");
+  vk::Buffer film = vk::createBuffer(ctx, std::max<std::size_t>(n, 1) * 16, 0, true, "sample output");
+  vk::Buffer filmSq = vk::createBuffer(ctx, std::max<std::size_t>(n, 1) * 16, 0, true, "sample output f");
+  vk::Buffer stats = vk::createBuffer(ctx, STAT_COUNT * 4, 0, true, "sampler stats");
+  std::memset(stats.mapped, 0, STAT_COUNT * 4);
+  vk::Buffer globals = vk::createBuffer(ctx, sizeof(Globals), 0, true, "sampler globals");
+  Globals g{};
+  g.frame = uvec4(0u, seed, 0u, 0u);
+  g.camForward = vec4(v, 0.0f);
+  g.materials = materials.address;
+  g.film = film.address;
+  g.filmSq = filmSq.address;
+  g.stats = stats.address;
+  g.quadSets = sets.address;
+  g.quadTables = tabs.address;
+  g.quadNodes = nodes.address;
+  g.quadLeaves = leaves.address;
+
+  // Descriptor set: binding 0 = the Globals block (as the renderer's stages).
+  VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  sl.bindingCount = 1;
+  sl.pBindings = &binding;
+  VkDescriptorSetLayout setLayout;
+  VK_CHECK(vkCreateDescriptorSetLayout(d, &sl, nullptr, &setLayout));
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(StageConstants)};
+  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &setLayout;
+  pl.pushConstantRangeCount = 1;
+  pl.pPushConstantRanges = &range;
+  VkPipelineLayout layout;
+  VK_CHECK(vkCreatePipelineLayout(d, &pl, nullptr, &layout));
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1};
+  VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  dp.maxSets = 1;
+  dp.poolSizeCount = 1;
+  dp.pPoolSizes = &size;
+  VkDescriptorPool pool;
+  VK_CHECK(vkCreateDescriptorPool(d, &dp, nullptr, &pool));
+  VkDescriptorSetAllocateInfo da{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  da.descriptorPool = pool;
+  da.descriptorSetCount = 1;
+  da.pSetLayouts = &setLayout;
+  VkDescriptorSet dset;
+  VK_CHECK(vkAllocateDescriptorSets(d, &da, &dset));
+  VkDescriptorBufferInfo bi{globals.buffer, 0, VK_WHOLE_SIZE};
+  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstSet = dset;
+  w.dstBinding = 0;
+  w.descriptorCount = 1;
+  w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  w.pBufferInfo = &bi;
+  vkUpdateDescriptorSets(d, 1, &w, 0, nullptr);
+  vk::ComputePipeline pipe = vk::createComputePipeline(ctx, layout, "sample_tool", {model});
+
+  auto t0 = std::chrono::steady_clock::now();
+  // Chunks of at most 65535 workgroups (maxComputeWorkGroupCount on lavapipe).
+  const std::uint32_t chunk = 65535u * WORKGROUP_SIZE;
+  for (std::uint32_t first = 0; first < n; first += chunk) {
+    std::uint32_t count = std::min(chunk, n - first);
+    g.image = uvec4(count, first, 0u, 0u);
+    std::memcpy(globals.mapped, &g, sizeof g);
+    VkCommandBuffer cmd = vk::beginOneShot(ctx);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &dset, 0, nullptr);
+    vkCmdDispatch(cmd, (count + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE, 1, 1);
+    vk::endOneShot(ctx, cmd);
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.wPdf.resize(n);
+  out.fOk.resize(n);
+  if (n) {
+    std::memcpy(out.wPdf.data(), film.mapped, std::size_t(n) * 16);
+    std::memcpy(out.fOk.data(), filmSq.mapped, std::size_t(n) * 16);
+  }
+  const std::uint32_t* s = static_cast<const std::uint32_t*>(stats.mapped);
+  out.boundViolations = s[STAT_SAMPLER_BOUND_VIOLATIONS];
+  out.trialFailures = s[STAT_SAMPLER_TRIAL_FAILURES];
+
+  vk::destroyComputePipeline(ctx, pipe);
+  vkDestroyDescriptorPool(d, pool, nullptr);
+  vkDestroyPipelineLayout(d, layout, nullptr);
+  vkDestroyDescriptorSetLayout(d, setLayout, nullptr);
+  for (vk::Buffer* b : {&materials, &sets, &tabs, &nodes, &leaves, &film, &filmSq, &stats, &globals}) vk::destroyBuffer(ctx, *b);
+  return out;
+}
+
+}  // namespace nusselt::quadtree

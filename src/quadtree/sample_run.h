@@ -1,0 +1,27 @@
+// sample_run.h: draw N directions with the generic sampler for one known direction, on the GPU
+// (stage sample_tool) or the CPU (the same shared code), for `nusselt sample` and the tests.
+// Sample i uses rng2(i, 0, RNG_DIM_BSDF, seed) and its rejection stream on both devices.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "quadtree/sampler_tables.h"
+#include "vk/vk.h"
+
+namespace nusselt::quadtree {
+
+struct SampleBatch {
+  std::vector<shared::vec4> wPdf;  // direction (local frame), pdf per unit solid angle (0: failed)
+  std::vector<shared::vec4> fOk;   // f rgb, 1 if the sample succeeded
+  std::uint64_t boundViolations = 0, trialFailures = 0;
+  std::uint64_t trials = 0;        // CPU only: rejection trials in total
+  double seconds = 0;
+};
+
+SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint32_t model, const shared::BrdfParams& params,
+                      shared::vec3 v, std::uint32_t n, std::uint32_t seed, unsigned threads = 0);
+
+SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32_t set, std::uint32_t model,
+                      const shared::BrdfParams& params, shared::vec3 v, std::uint32_t n, std::uint32_t seed);
+
+}  // namespace nusselt::quadtree

@@ -1,0 +1,70 @@
+// sampler_tables.h: the generic sampler's trees for the materials of a render, built on the CPU
+// in parallel (only for the materials used), cached on disk, flattened into the four buffers of
+// shaders/shared/quadtree_layout.h; and the scope that lets C++ call the shared sampling code of
+// shaders/shared/quadtree.h (quadSample, quadPdf, quadAlbedo) on those arrays.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "../../shaders/shared/quadtree.h"
+
+namespace nusselt::quadtree {
+
+struct QuadtreeSettings {
+  std::uint32_t thetaTables = 90;  // tables at theta_k = k * 90 deg / thetaTables (paper: 90)
+  std::uint32_t phiTables = 16;    // anisotropic models only: phi_j = j * 90 deg / (phiTables - 1)
+  float nMax = 2.0f;               // split rule of the paper: every uncapped leaf accepts >= 1/nMax
+  std::uint32_t maxDepth = 14;     // depth cap (cells of 2^-13 at the cap); see docs/sampler.md
+  float defensive = 0.1f;          // cosine fraction between tables (none exactly on a table)
+  bool useCache = true;            // $NUSSELT_CACHE_DIR, else $XDG_CACHE_HOME/nusselt, else ~/.cache/nusselt
+  unsigned threads = 0;            // 0: std::thread::hardware_concurrency()
+};
+
+struct MaterialStats {
+  std::uint32_t model = 0;
+  std::uint32_t set = INVALID_INDEX;
+  std::uint32_t trees = 0, nodes = 0, leaves = 0, cappedLeaves = 0, rimLeaves = 0, maxDepth = 0;
+  double minAcceptance = 1;
+  std::uint64_t bytes = 0;
+  std::uint64_t evaluations = 0;
+  bool cacheHit = false;
+  double buildSeconds = 0;  // CPU seconds summed over its trees (0 on a cache hit)
+};
+
+struct SamplerTables {
+  std::vector<shared::QuadSet> sets;
+  std::vector<shared::QuadTable> tables;
+  std::vector<shared::QuadNode> nodes;
+  std::vector<shared::QuadLeaf> leaves;
+  std::vector<MaterialStats> materials;  // one per distinct material built (= per set)
+  double seconds = 0;                    // wall time of buildSamplerTables
+  std::uint32_t cacheHits = 0, cacheMisses = 0, cacheRejected = 0;  // rejected: corrupt/stale
+  std::uint64_t bytes() const;
+};
+
+// For each material its QuadSet index (INVALID_INDEX for delta models) in setIndexPerMaterial.
+// Identical (model, params) share one set. Trees are built in parallel and cached.
+SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, shared::BrdfParams>>& materials,
+                                 const QuadtreeSettings& settings, std::vector<std::uint32_t>& setIndexPerMaterial);
+
+// The cache directory in use ("" when none is writable).
+std::string cacheDirectory();
+
+// While alive, quadSample / quadPdf / quadAlbedo called from this thread read `tables` and count
+// into `counters` (boundViolations, trialFailures, trials, samples).
+class QuadHostScope {
+ public:
+  explicit QuadHostScope(const SamplerTables& tables);
+  ~QuadHostScope();
+  QuadHostScope(const QuadHostScope&) = delete;
+  QuadHostScope& operator=(const QuadHostScope&) = delete;
+  const shared::QuadHost& counters() const { return m_host; }
+
+ private:
+  shared::QuadHost m_host;
+  shared::QuadHost* m_previous;
+};
+
+}  // namespace nusselt::quadtree

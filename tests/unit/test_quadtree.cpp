@@ -1,0 +1,180 @@
+// test_quadtree.cpp: the generic quadtree sampler on the CPU (the shared code of
+// shaders/shared/quadtree.h): tree totals against directionalAlbedo, chi-square goodness of fit,
+// weights at and between tables, acceptance, bound violations, trial failures, and the cache.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "brdf/albedo.h"
+#include "quadtree/quadtree_build.h"
+#include "test_quadtree_chi2.h"
+
+using namespace nusselt;
+using namespace nusselt::shared;
+
+namespace {
+
+const quadtree::SamplerTables& tablesFor(const std::string& model, bool hard, std::uint32_t& set) {
+  static std::map<std::string, quadtree::SamplerTables> cache;
+  std::string key = model + (hard ? "/hard" : "/typical");
+  auto it = cache.find(key);
+  if (it == cache.end()) {
+    const ModelSpec* m = findModel(model);
+    BrdfParams p = packParams(*m, hard ? hardParams(*m) : typicalParams(*m), key);
+    std::vector<std::uint32_t> idx;
+    it = cache.emplace(key, quadtree::buildSamplerTables({{m->id, p}}, qttest::testSettings(), idx)).first;
+  }
+  set = 0;
+  return it->second;
+}
+
+// Integral over the disc of luminance f(w, v), v = (sin th, 0, cos th): composite Gauss-Legendre
+// in (u = r^2, phi), dA = du dphi / 2 (for the non-reciprocal strauss).
+double albedoSecondArgument(std::uint32_t model, const BrdfParams& p, double th) {
+  static const double gx[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
+  static const double gw[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
+  vec3 v(float(std::sin(th)), 0.0f, float(std::cos(th)));
+  const int P = 256;
+  double sum = 0;
+  for (int a = 0; a < P; ++a)
+    for (int b = 0; b < P; ++b)
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j) {
+          double u = (a + 0.5 * (1 + gx[i])) / P, ph = 2 * M_PI * (b + 0.5 * (1 + gx[j])) / P;
+          double r = std::sqrt(u), co = std::sqrt(1 - u);
+          vec3 w(float(r * std::cos(ph)), float(r * std::sin(ph)), float(co));
+          sum += gw[i] * gw[j] * quadEvalLum(model, p, w, v);
+        }
+  return sum * 0.25 * (1.0 / P) * (2 * M_PI / P) * 0.5;
+}
+
+}  // namespace
+
+// Each tree's total (integral of luminance f over the disc) is the directional albedo.
+TEST(Quadtree, TreeTotalsMatchDirectionalAlbedo) {
+  double worst = 0;
+  std::string worstName;
+  for (const ModelSpec& m : allModels()) {
+    if (m.delta) continue;
+    for (int hard = 0; hard < 2; ++hard) {
+      BrdfParams p = packParams(m, hard ? hardParams(m) : typicalParams(m), m.name);
+      for (double t : {0.0, 30.0, 60.0, 85.0}) {
+        double th = t * M_PI / 180;
+        quadtree::Tree tree = quadtree::buildTree(m.id, p, vec3(float(std::sin(th)), 0.0f, float(std::cos(th))), {});
+        // strauss is not reciprocal: the tree integrates f(., v) (v = the second argument, wo), which
+        // directionalAlbedo (integral over wo) does not; compare with our own quadrature there.
+        double a = m.id == MODEL_STRAUSS ? albedoSecondArgument(m.id, p, th) : directionalAlbedo(m.id, p, t);
+        double err = std::abs(tree.mass - a) / std::max(a, 1e-30);
+        EXPECT_LE(err, 1e-4) << m.name << (hard ? " hard" : " typical") << " theta " << t << ": tree " << tree.mass
+                             << " albedo " << a;
+        if (err > worst) { worst = err; worstName = m.name + (hard ? " hard " : " typical ") + std::to_string(t); }
+      }
+    }
+  }
+  std::printf("worst relative difference tree total vs directionalAlbedo: %.3g (%s)\n", worst, worstName.c_str());
+}
+
+// Chi-square of CPU samples against the sampler's pdf, for the case matrix; the weight
+// f cos / pdf equals the tabulated albedo on tables; zero bound violations and trial failures.
+TEST(Quadtree, ChiSquareCpu) {
+  std::vector<qttest::Case> cases = qttest::caseMatrix();
+  const double alpha = 0.01;
+  const double cellAlpha = 1 - std::pow(1 - alpha, 1.0 / cases.size());  // Sidak
+  const std::uint32_t n = 200000;
+  std::uint64_t totalViolations = 0, totalFailures = 0;
+  double spreadLo = 1e30, spreadHi = 0;
+  int failures = 0;
+  for (const qttest::Case& c : cases) {
+    std::uint32_t set;
+    const quadtree::SamplerTables& t = tablesFor(c.model, c.hard, set);
+    const ModelSpec* m = findModel(c.model);
+    BrdfParams p = qttest::caseParams(c);
+    vec3 v = qttest::knownDirection(c);
+    quadtree::SampleBatch b = quadtree::sampleCpu(t, set, m->id, p, v, n, 1234u);
+    totalViolations += b.boundViolations;
+    totalFailures += b.trialFailures;
+    EXPECT_EQ(b.boundViolations, 0u) << c.name();
+    EXPECT_EQ(b.trialFailures, 0u) << c.name();
+    qttest::Chi2Result r;
+    {
+      quadtree::QuadHostScope scope(t);
+      r = qttest::chiSquare(set, m->id, p, v, b.wPdf);
+    }
+    // Weights f cos / pdf relative to the tabulated albedo.
+    float albedo;
+    bool onTable = std::fmod(c.thetaDeg, 5.0) == 0.0 && c.phiDeg == 0.0;
+    {
+      quadtree::QuadHostScope scope(t);
+      albedo = quadAlbedo(set, v.z, float(c.phiDeg * M_PI / 180));
+    }
+    double lo = 1e30, hi = 0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      if (b.fOk[i].w <= 0) continue;
+      double wgt = luminance(vec3(b.fOk[i])) * b.wPdf[i].z / b.wPdf[i].w / albedo;
+      lo = std::min(lo, wgt);
+      hi = std::max(hi, wgt);
+    }
+    if (onTable) {
+      EXPECT_NEAR(lo, 1.0, 2e-3) << c.name();
+      EXPECT_NEAR(hi, 1.0, 2e-3) << c.name();
+    } else {
+      spreadLo = std::min(spreadLo, lo);
+      spreadHi = std::max(spreadHi, hi);
+    }
+    double trialsPerSample = double(b.trials) / n;
+    std::printf("%-48s p=%.3g chi2=%.1f dof=%d sum(pdf)=%.5f weight/a in [%.6f, %.6f] trials/sample=%.3f\n",
+                c.name().c_str(), r.pValue, r.chi2, r.dof, r.expectedTotal, lo, hi, trialsPerSample);
+    EXPECT_NEAR(r.expectedTotal, 1.0, 2e-3) << c.name();
+    EXPECT_LE(trialsPerSample, 2.5) << c.name();
+    if (r.pValue < cellAlpha) {
+      ++failures;
+      ADD_FAILURE() << c.name() << ": chi-square p-value " << r.pValue << " < " << cellAlpha << "\n" << r.dump;
+    }
+  }
+  std::printf("%zu cases, %d chi-square failures, bound violations %llu, trial failures %llu; between tables weight/albedo in [%.4f, %.4f]\n",
+              cases.size(), failures, static_cast<unsigned long long>(totalViolations),
+              static_cast<unsigned long long>(totalFailures), spreadLo, spreadHi);
+}
+
+// A second build of the same material comes from the cache; a corrupt entry is detected and rebuilt.
+TEST(Quadtree, DiskCache) {
+  namespace fs = std::filesystem;
+  fs::path dir = fs::temp_directory_path() / ("nusselt-qt-cache-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  ::setenv("NUSSELT_CACHE_DIR", dir.c_str(), 1);
+  const ModelSpec* m = findModel("phong");
+  BrdfParams p = packParams(*m, typicalParams(*m), "phong");
+  quadtree::QuadtreeSettings s;
+  s.thetaTables = 6;
+  std::vector<std::uint32_t> idx;
+  quadtree::SamplerTables a = quadtree::buildSamplerTables({{m->id, p}}, s, idx);
+  EXPECT_EQ(a.cacheMisses, 1u);
+  quadtree::SamplerTables b = quadtree::buildSamplerTables({{m->id, p}}, s, idx);
+  EXPECT_EQ(b.cacheHits, 1u);
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  EXPECT_EQ(0, std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(QuadNode)));
+  // Corrupt one byte of the payload.
+  fs::path file;
+  for (const auto& e : fs::directory_iterator(dir)) file = e.path();
+  {
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(200);
+    char c = 0x5a;
+    f.write(&c, 1);
+  }
+  quadtree::SamplerTables c = quadtree::buildSamplerTables({{m->id, p}}, s, idx);
+  EXPECT_EQ(c.cacheRejected, 1u);
+  EXPECT_EQ(0, std::memcmp(a.leaves.data(), c.leaves.data(), a.leaves.size() * sizeof(QuadLeaf)));
+  // Truncated file.
+  fs::resize_file(file, 100);
+  quadtree::SamplerTables d = quadtree::buildSamplerTables({{m->id, p}}, s, idx);
+  EXPECT_EQ(d.cacheRejected, 1u);
+  quadtree::SamplerTables e = quadtree::buildSamplerTables({{m->id, p}}, s, idx);
+  EXPECT_EQ(e.cacheHits, 1u);
+  ::unsetenv("NUSSELT_CACHE_DIR");
+  fs::remove_all(dir);
+}
