@@ -68,9 +68,10 @@ const char* const kKeysHelp =
     "  Esc, Q, closing the window       quit\n"
     "The title bar shows spp, samples/s, sampler, lighting, exposure and the device.";
 
-// The sampling strategies the keys 1-5 name. RenderSettings has no strategy choice yet (the
-// generic samplers arrive with `--sampler`): every model is cosine sampled, so that is the only
-// one reported as available. When RenderSettings gains a sampler field, this is where it plugs in.
+// The sampling strategies the keys 1-5 name; a key switches RenderSettings::sampler (the shade
+// stages are specialised per strategy, so the renderer is recreated). analytic and tabulated are
+// the comparison strategies of the speed-versus-error benchmark and are not implemented yet: their
+// keys say so.
 struct SamplerKey {
   const char* name;
   int key;
@@ -80,7 +81,10 @@ const SamplerKey kSamplers[] = {{"quadtree", GLFW_KEY_1},
                                 {"analytic", GLFW_KEY_3},
                                 {"tabulated", GLFW_KEY_4},
                                 {"uniform", GLFW_KEY_5}};
-bool samplerAvailable(const std::string& name) { return name == "cosine"; }
+bool samplerAvailable(const std::string& name) {
+  SamplerKind kind;
+  return parseSampler(name, kind);
+}
 
 std::atomic<int> g_stopSignal{0};
 void onSignal(int sig) {
@@ -111,6 +115,7 @@ struct PreviewArgs {
   std::uint32_t seed = 0;
   std::uint32_t maxDepth = 8;
   std::string lighting = "mis";
+  std::string sampler = "quadtree";
   std::string tonemap = "clamp";
   int device = -1;
   float exposure = 0.0f;
@@ -303,7 +308,7 @@ class Preview {
   bool m_paused = false;
   bool m_reinhard = false;
   float m_exposure = 0.0f;
-  std::string m_sampler = "cosine";
+  std::string m_sampler = "quadtree";
   double m_lastX = 0, m_lastY = 0;
   bool m_haveCursor = false;
 
@@ -378,13 +383,13 @@ void Preview::onKey(int key, int mods) {
         if (samplerAvailable(name)) {
           if (m_sampler != name) {
             m_sampler = name;
-            m_renderer->reset();
+            parseSampler(m_sampler, m_settings.sampler);
+            m_lightingDirty = true;  // recreate the renderer with the new strategy
           }
           break;
         }
       }
-      std::fprintf(stderr, "sampler: %s (only cosine is available until the generic samplers land)\n",
-                   m_sampler.c_str());
+      std::fprintf(stderr, "sampler: %s\n", m_sampler.c_str());
       updateTitle(true);
       return;
     }
@@ -396,11 +401,12 @@ void Preview::onKey(int key, int mods) {
   for (const SamplerKey& s : kSamplers) {
     if (key != s.key) continue;
     if (!samplerAvailable(s.name)) {
-      std::fprintf(stderr, "sampler %s is not available yet: only cosine (the sampling strategies arrive with "
-                           "`--sampler`); staying with %s\n", s.name, m_sampler.c_str());
+      std::fprintf(stderr, "sampler %s is not available yet (quadtree, cosine and uniform are); staying with %s\n",
+                   s.name, m_sampler.c_str());
     } else if (m_sampler != s.name) {
       m_sampler = s.name;
-      m_renderer->reset();
+      parseSampler(m_sampler, m_settings.sampler);
+      m_lightingDirty = true;  // recreate the renderer with the new strategy
       std::fprintf(stderr, "sampler: %s\n", s.name);
     }
     updateTitle(true);
@@ -729,6 +735,8 @@ int Preview::run() {
   m_settings.seed = a.seed;
   m_settings.maxDepth = a.maxDepth;
   m_settings.lighting = parseLighting(a.lighting);
+  m_sampler = a.sampler;
+  parseSampler(m_sampler, m_settings.sampler);
   m_settings.spp = 1;
   m_exposure = a.exposure;
   m_reinhard = a.tonemap == "reinhard";
@@ -929,6 +937,8 @@ void registerPreviewCommand(CLI::App& app, CommandRunner& run) {
   p->add_option("--seed", a->seed, "Random seed (same as `render --seed`: same view and spp give the same film)")
       ->capture_default_str();
   p->add_option("--max-depth", a->maxDepth, "Maximum path depth")->capture_default_str()->check(CLI::Range(0u, 1024u));
+  p->add_option("--sampler", a->sampler, "BSDF sampling at start (keys 1-5 and Tab switch): quadtree, cosine, uniform")
+      ->capture_default_str()->check(CLI::IsMember({"quadtree", "cosine", "uniform"}));
   p->add_option("--lighting", a->lighting, "Light transport estimator at start (L switches): mis, nee, bsdf")
       ->capture_default_str()->check(CLI::IsMember({"mis", "nee", "bsdf"}));
   p->add_option("--exposure", a->exposure, "Display exposure in stops ([ and ] change it)")->capture_default_str();
