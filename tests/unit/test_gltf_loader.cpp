@@ -319,6 +319,22 @@ TEST(GltfLoader, MaterialsBrdfAndEmission) {
   EXPECT_FLOAT_EQ(s.materials[1].params.v[0][1], 0.2f);
   EXPECT_EQ(s.triangleMaterial[0], 1u);
   EXPECT_TRUE(s.warnings.empty());
+  // Without NUSSELT_brdf: the glTF metallic-roughness BRDF with the material's factors (glTF
+  // defaults metallic 1, roughness 1 when absent).
+  EXPECT_EQ(s.materials[0].model, MODEL_GLTF_PBR);
+  EXPECT_FLOAT_EQ(shared::brdfParam(s.materials[0].params, GLTF_PBR_METALLIC), 1.0f);
+  EXPECT_FLOAT_EQ(shared::brdfParam(s.materials[0].params, GLTF_PBR_ROUGHNESS), 1.0f);
+  EXPECT_EQ(s.materials[1].model, MODEL_LAMBERT);
+  {
+    Json k = j;
+    k["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 0.25;
+    k["materials"][0]["pbrMetallicRoughness"]["roughnessFactor"] = 0.5;
+    Scene t = loadJson(k);
+    EXPECT_FLOAT_EQ(shared::brdfParam(t.materials[0].params, GLTF_PBR_METALLIC), 0.25f);
+    EXPECT_FLOAT_EQ(shared::brdfParam(t.materials[0].params, GLTF_PBR_ROUGHNESS), 0.5f);
+    k["materials"][0]["pbrMetallicRoughness"]["roughnessFactor"] = 1.5;
+    EXPECT_NE(jsonError(k).find("roughnessFactor"), std::string::npos);
+  }
 
   j.erase("extensionsUsed");
   s = loadJson(j);
