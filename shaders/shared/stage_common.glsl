@@ -40,13 +40,17 @@ void queuePush(uint queue, uint path) {
 
 // ---- Rays -----------------------------------------------------------------------------------
 
-// Move a ray origin off a surface along its geometric normal n by a few ulps of the position:
-// scale-invariant, so scenes from 1e-4 to 1e6 units work (Waechter and Binder, "A Fast and
-// Robust Method for Avoiding Self-Intersection", Ray Tracing Gems, ch. 6, 2019).
+// Move a ray origin off a surface along its geometric normal n by a few ulps of the position
+// (Waechter and Binder, "A Fast and Robust Method for Avoiding Self-Intersection", Ray Tracing
+// Gems, ch. 6, 2019). Their fixed constants assume a scene of size ~1 near the origin: near the
+// origin they add an absolute 1/65536, which is 15 % of a scene of size 1e-4. Here both the
+// near-origin threshold and that offset scale with the scene's bounding radius, so scenes from
+// 1e-4 to 1e6 units behave alike; elsewhere the offset is 256 ulps of each coordinate.
 vec3 offsetRay(vec3 p, vec3 n) {
-  const float origin = 1.0f / 32.0f;
-  const float floatScale = 1.0f / 65536.0f;
   const float intScale = 256.0f;
+  float scale = max(g.sceneSphere.w, 1e-30f);
+  float origin = scale / 32.0f;
+  float floatScale = scale / 65536.0f;
   ivec3 of = ivec3(intScale * n.x, intScale * n.y, intScale * n.z);
   vec3 pi = vec3(intBitsToFloat(floatBitsToInt(p.x) + ((p.x < 0.0f) ? -of.x : of.x)),
                  intBitsToFloat(floatBitsToInt(p.y) + ((p.y < 0.0f) ? -of.y : of.y)),
