@@ -36,6 +36,9 @@ ModelTraits modelTraits(std::uint32_t model, const BrdfParams& p) {
       t.anisotropic = brdfParam(p, SCHLICK_P) < 1.0f;
       break;
     case MODEL_BEARD_MAXWELL: t.rimExponent = 1.0f; break;
+    // strauss' specular term carries 1 / cos(theta_i) of the SAMPLED direction (it is not
+    // reciprocal): f(., v) ~ 1 / cos at the rim wherever the lobe reaches it.
+    case MODEL_STRAUSS: t.rimExponent = 1.0f; break;
     case MODEL_ASHIKHMIN_SHIRLEY:
       t.anisotropic = brdfParam(p, ASHIKHMIN_SHIRLEY_NU) != brdfParam(p, ASHIKHMIN_SHIRLEY_NV);
       break;

@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -23,7 +24,7 @@ using namespace shared;
 namespace {
 
 // Bump when the tree format or the build algorithm changes: old cache entries become stale.
-constexpr std::uint32_t kFormatVersion = 3;
+constexpr std::uint32_t kFormatVersion = 4;  // 4: strauss rim exponent
 constexpr char kMagic[8] = {'N', 'U', 'S', 'Q', 'T', 'R', 'E', 'E'};
 
 std::uint64_t fnv1a(const void* data, std::size_t n, std::uint64_t h = 1469598103934665603ull) {
@@ -226,7 +227,7 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
 
   // ---- Cache look-up ----
   for (Unique& u : uniques) {
-    if (!settings.useCache) continue;
+    if (!settings.useCache || !settings.onlyThetaTables.empty()) continue;
     int r = loadCache(u.key, u.trees);
     if (r == 0 && u.trees.tables.size() == std::size_t(u.nTheta) * u.nPhi) {
       u.fromCache = true;
@@ -253,7 +254,11 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
     for (std::uint32_t k = 0; k < u.nTheta; ++k)
       for (std::uint32_t j = 0; j < u.nPhi; ++j) u.trees.tables[k * u.nPhi + j] = makeTable(k, j, u.nTheta, u.nPhi);
     // Most expensive first (grazing tables are the deepest): better balance.
-    for (std::uint32_t t = n; t-- > 0;) jobs.push_back({ui, t});
+    for (std::uint32_t t = n; t-- > 0;) {
+      const auto& only = settings.onlyThetaTables;
+      if (!only.empty() && std::find(only.begin(), only.end(), t / u.nPhi) == only.end()) continue;
+      jobs.push_back({ui, t});
+    }
   }
   std::atomic<std::size_t> next{0};
   auto worker = [&]() {
@@ -306,7 +311,7 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
         st.buildSeconds += u.seconds[t];
       }
       u.built.clear();
-      if (settings.useCache) storeCache(u.key, u.trees);
+      if (settings.useCache && settings.onlyThetaTables.empty()) storeCache(u.key, u.trees);
     }
     st.trees = std::uint32_t(u.trees.tables.size());
     st.nodes = std::uint32_t(u.trees.nodes.size());

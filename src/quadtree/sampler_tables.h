@@ -20,6 +20,9 @@ struct QuadtreeSettings {
   float defensive = 0.1f;          // cosine fraction between tables (none exactly on a table)
   bool useCache = true;            // $NUSSELT_CACHE_DIR, else $XDG_CACHE_HOME/nusselt, else ~/.cache/nusselt
   unsigned threads = 0;            // 0: std::thread::hardware_concurrency()
+  // Tests only: when not empty, only these theta indices are built (all their phi tables); the
+  // other tables stay empty (mass 0: sampling there fails). Never cached.
+  std::vector<std::uint32_t> onlyThetaTables;
 };
 
 struct MaterialStats {
