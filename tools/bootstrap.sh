@@ -17,6 +17,7 @@ packages=(
   libcli11-dev                               # command-line parsing
   libgtest-dev                               # tests
   xvfb xauth python3                         # preview tests (an X server; PNG checks)
+  clang libclang-rt-14-dev llvm              # fuzzers (libFuzzer) and sanitizer runtimes, llvm-symbolizer
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -6,6 +6,8 @@
 //   - read the file ourselves (regular file, size cap) and split GLB chunks with checked sizes,
 //   - parse the JSON once with nlohmann (after a cheap nesting-depth scan, because tinygltf
 //     converts extension values recursively) and vet every buffer URI against the scene folder,
+//   - refuse integers tinygltf would truncate to int, a BIN-chunk buffer other than buffers[0] or
+//     of byteLength 0, and buffers adding up to more than 1 GiB (tinygltf copies per buffer),
 //   - drop `images` (not supported yet) so no image bytes are ever decoded or sliced,
 // and hand tinygltf file-system callbacks that only open regular files inside the scene folder.
 // After tinygltf, every index and every accessor is checked before a single byte is read.
@@ -288,18 +290,76 @@ void checkUnsignedFields(const Json& root, const char* array, std::initializer_l
   }
 }
 
-// Checks buffers[i].uri against the sandbox; data URIs must decode to exactly byteLength bytes.
-void checkBufferUris(const Json& root, const Sandbox& box, const std::string& name) {
+// tinygltf 2.7.0 reads JSON integers through static_cast<int>(get<int64_t>()) (GetInt for index
+// and enum fields, ParseJsonAsValue for extension values): 4294967296 becomes index 0 and
+// 4294967396 becomes parameter value 100, silently in range. So, before tinygltf sees the JSON,
+// an integer that does not fit an int is
+//   - turned into the same number as a double inside `extensions` (NUSSELT_brdf parameters,
+//     emissiveStrength: numbers that are range-checked as numbers afterwards) and in the glTF
+//     fields tinygltf reads as doubles anyway (translation, yfov, min, ...),
+//   - left alone in `extras` (never read) and in the size_t fields (read without truncation),
+//   - refused everywhere else: there glTF expects an index or an enum.
+const char* const kNumberFields[] = {"min", "max", "translation", "rotation", "scale", "matrix", "weights",
+                                     "baseColorFactor", "emissiveFactor", "metallicFactor", "roughnessFactor",
+                                     "alphaCutoff", "strength", "yfov", "aspectRatio", "znear", "zfar", "xmag",
+                                     "ymag", "intensity", "color", "range", "innerConeAngle", "outerConeAngle"};
+
+void checkIntegers(Json& j, const std::string& path, bool asNumber, const std::string& name) {
+  if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      const std::string& key = it.key();
+      if (key == "extras") continue;
+      if (!asNumber && (key == "byteLength" || key == "byteOffset" || key == "byteStride" || key == "count")) continue;
+      bool number = asNumber || key == "extensions";
+      for (const char* f : kNumberFields) number = number || key == f;
+      checkIntegers(it.value(), path + "." + key, number, name);
+    }
+  } else if (j.is_array()) {
+    for (std::size_t i = 0; i < j.size(); ++i)
+      checkIntegers(j[i], path + "[" + str(std::uint64_t(i)) + "]", asNumber, name);
+  } else if (j.is_number_unsigned() || j.is_number_integer()) {
+    const bool fits = j.is_number_unsigned() ? j.get<std::uint64_t>() <= std::uint64_t(std::numeric_limits<int>::max())
+                                             : j.get<std::int64_t>() >= std::numeric_limits<int>::min() &&
+                                                   j.get<std::int64_t>() <= std::numeric_limits<int>::max();
+    if (fits) return;
+    if (asNumber) {
+      j = j.get<double>();
+      return;
+    }
+    throw Error(name + ": " + path.substr(1) + ": " + j.dump() + " is out of range for an index (at most " +
+                str(std::numeric_limits<int>::max()) + ")");
+  }
+}
+
+// Checks the buffers before tinygltf copies them: buffers[i].uri against the sandbox (data URIs
+// must decode to exactly byteLength bytes), the GLB BIN chunk reference, and the total size.
+// tinygltf 2.7.0 copies the BIN chunk once for every buffer without a uri and reads an external
+// file once for every buffer naming it, so a small file could otherwise ask for gigabytes; and it
+// takes &data.at(0) of an empty vector for a BIN buffer of byteLength 0 (std::out_of_range).
+void checkBuffers(const Json& root, const Sandbox& box, const std::string& name, bool binary, std::uint64_t binSize) {
   auto buffers = root.find("buffers");
   if (buffers == root.end() || !buffers->is_array()) return;
+  std::uint64_t total = 0;
   for (std::size_t i = 0; i < buffers->size(); ++i) {
     const Json& b = (*buffers)[i];
+    const std::string at = name + ": buffers[" + str(std::uint64_t(i)) + "]";
+    auto bl = b.find("byteLength");
+    const std::uint64_t declared = bl != b.end() && bl->is_number_unsigned() ? bl->get<std::uint64_t>() : 0;
+    if (!addChecked(total, declared, &total) || total > kMaxFileBytes)
+      throw Error(at + ".byteLength: the buffers add up to more than the 1 GiB limit");
     auto u = b.find("uri");
-    if (u == b.end()) continue;
-    const std::string field = name + ": buffers[" + str(std::uint64_t(i)) + "].uri";
+    if (u == b.end()) {
+      if (!binary) throw Error(at + ": no uri (only a .glb file can hold a buffer without one)");
+      if (i != 0) throw Error(at + ": no uri, but only buffers[0] can refer to the GLB BIN chunk");
+      if (binSize == 0) throw Error(at + ": refers to the GLB BIN chunk, but the file has none (or it is empty)");
+      if (declared == 0 || declared > binSize)
+        throw Error(at + ".byteLength: " + str(declared) + " must be between 1 and the BIN chunk size " + str(binSize));
+      continue;
+    }
+    const std::string field = at + ".uri";
     if (!u->is_string()) throw Error(field + ": not a string");
     const std::string& uri = u->get_ref<const std::string&>();
-    std::uint64_t byteLength = b.value("byteLength", Json(0)).is_number_unsigned() ? b["byteLength"].get<std::uint64_t>() : 0;
+    const std::uint64_t byteLength = declared;
     if (uri.compare(0, 5, "data:") == 0) {
       const char* prefix = nullptr;
       for (const char* p : kDataUriPrefixes)
@@ -514,18 +574,27 @@ class Converter {
       m.model = spec->id;
       m.params = packParams(*spec, params, context);
     } else {
-      // Without NUSSELT_brdf a glTF PBR material becomes Lambertian with rho =
-      // pbrMetallicRoughness.baseColorFactor.rgb clamped to [0, 1]. metallicFactor,
-      // roughnessFactor and alpha are ignored: there is no metal or glossy model in the default
-      // mapping yet, and the diffuse reading of the base colour is the energy-conserving choice.
-      const std::vector<double>& c = gm.pbrMetallicRoughness.baseColorFactor;
+      // Without NUSSELT_brdf a material uses the glTF 2.0 metallic-roughness BRDF itself
+      // (gltf_pbr): baseColor = baseColorFactor.rgb clamped to [0, 1] (alpha is ignored),
+      // metallic = metallicFactor, roughness = roughnessFactor (glTF defaults 1 and 1).
+      const tinygltf::PbrMetallicRoughness& pbr = gm.pbrMetallicRoughness;
+      const std::vector<double>& c = pbr.baseColorFactor;
       if (c.size() != 4 || !allFinite(c))
         fail(field + ".pbrMetallicRoughness.baseColorFactor: expected 4 finite numbers");
-      ParamValue rho;
-      rho.kind = ParamValue::Kind::Array;
-      for (int k = 0; k < 3; ++k) rho.items.push_back(ParamValue::num(std::clamp(c[std::size_t(k)], 0.0, 1.0)));
-      m.model = MODEL_LAMBERT;
-      m.params = packParams(*findModel("lambert"), {{"rho", rho}}, name_ + ": " + field);
+      ParamValue base;
+      base.kind = ParamValue::Kind::Array;
+      for (int k = 0; k < 3; ++k) base.items.push_back(ParamValue::num(std::clamp(c[std::size_t(k)], 0.0, 1.0)));
+      auto factor = [&](double v, const char* name) {
+        if (!std::isfinite(v) || v < 0 || v > 1)
+          fail(field + ".pbrMetallicRoughness." + name + ": " + fmt(v) + " is not in [0, 1]");
+        return ParamValue::num(v);
+      };
+      m.model = MODEL_GLTF_PBR;
+      m.params = packParams(*findModel("gltf_pbr"),
+                            {{"baseColor", base},
+                             {"metallic", factor(pbr.metallicFactor, "metallicFactor")},
+                             {"roughness", factor(pbr.roughnessFactor, "roughnessFactor")}},
+                            name_ + ": " + field);
     }
 
     const std::vector<double>& e = gm.emissiveFactor;
@@ -1021,7 +1090,8 @@ Scene loadImpl(const unsigned char* bytes, std::uint64_t size, const std::string
   checkUnsignedFields(root, "buffers", {"byteLength"}, name);
   checkUnsignedFields(root, "bufferViews", {"byteOffset", "byteLength", "byteStride"}, name);
   checkUnsignedFields(root, "accessors", {"byteOffset", "count"}, name);
-  checkBufferUris(root, box, name);
+  checkIntegers(root, "", false, name);
+  checkBuffers(root, box, name, binary, glb.hasBin ? glb.binSize : 0);
   std::vector<std::string> earlyWarnings;
   if (auto images = root.find("images"); images != root.end()) {
     std::size_t n = images->is_array() ? images->size() : 0;
