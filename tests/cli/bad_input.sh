@@ -52,6 +52,15 @@ expect_error bad_lighting "--lighting" -- --lighting nonsense
 expect_error width_zero "--width" -- --width 0
 expect_error device_memory "device memory" -- --width 60000 --height 4000
 
+# No Vulkan driver (the loader finds no ICD): a message naming the Debian package, exit 1.
+if VK_ICD_FILENAMES=/nonexistent/icd.json "$nusselt" render -o "$work/nodriver.exr" --spp 1 --width 8 -q 2>"$work/stderr"; then
+  echo "FAIL no_driver: exit status 0"; fails=$((fails + 1))
+elif grep -q "mesa-vulkan-drivers" "$work/stderr" && [ ! -e "$work/nodriver.exr" ]; then
+  echo "ok   no_driver: $(cat "$work/stderr")"
+else
+  echo "FAIL no_driver: $(cat "$work/stderr")"; fails=$((fails + 1))
+fi
+
 # Degenerate geometry is not an error: dropped, counted in one warning, and the scene renders.
 out=$work/degenerate.exr
 if "$nusselt" render "$data/degenerate.gltf" -o "$out" --spp 1 --width 8 --height 8 2>"$work/stderr"; then
