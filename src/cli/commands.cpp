@@ -14,6 +14,7 @@
 #include <iostream>
 
 #include "brdf/albedo.h"
+#include "cli/cli_common.h"
 #include "io/image.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
@@ -22,42 +23,7 @@
 #include "vk/vk.h"
 
 namespace nusselt {
-extern const unsigned char kDefaultSceneBytes[];
-extern const std::size_t kDefaultSceneSize;
-
 namespace {
-
-std::atomic<int> g_stopSignal{0};
-
-void onSignal(int sig) {
-  g_stopSignal.store(sig);
-  // A second signal ends the program at once.
-  std::signal(sig, SIG_DFL);
-}
-
-bool validationFromEnvironment() {
-  const char* v = std::getenv("NUSSELT_VALIDATION");
-  return v && *v && std::string(v) != "0";
-}
-
-// Checks that `path` can be written (its directory exists and is writable) before any work.
-void checkOutputPath(const std::string& path, const std::string& option) {
-  namespace fs = std::filesystem;
-  fs::path p(path);
-  fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw Error(option + " " + path + ": directory " + dir.string() + " does not exist");
-  if (fs::is_directory(p, ec)) throw Error(option + " " + path + ": is a directory");
-  if (access(dir.c_str(), W_OK) != 0) throw Error(option + " " + path + ": directory " + dir.string() + " is not writable");
-}
-
-Scene loadSceneOrDefault(const std::string& path, const std::string& camera) {
-  LoadOptions opts;
-  opts.cameraName = camera;
-  if (path.empty()) return loadSceneFromMemory(kDefaultSceneBytes, kDefaultSceneSize, "default scene (cornell-box.glb)", opts);
-  return loadScene(path, opts);
-}
 
 void printSceneWarnings(const Scene& scene, bool quiet) {
   if (quiet) return;
@@ -181,8 +147,8 @@ int renderCommand(const RenderArgs& a) {
 
   // A signal from here on is handled: before the first pass it just ends without output.
   g_stopSignal = 0;
-  auto oldInt = std::signal(SIGINT, onSignal);
-  auto oldTerm = std::signal(SIGTERM, onSignal);
+  auto oldInt = std::signal(SIGINT, onStopSignal);
+  auto oldTerm = std::signal(SIGTERM, onStopSignal);
   struct RestoreSignals {
     void (*i)(int);
     void (*t)(int);

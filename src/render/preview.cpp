@@ -30,6 +30,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "cli/cli_common.h"
 #include "cli/commands.h"
 #include "io/image.h"
 #include "render/renderer.h"
@@ -41,8 +42,6 @@
 #include <GLFW/glfw3.h>
 
 namespace nusselt {
-extern const unsigned char kDefaultSceneBytes[];
-extern const std::size_t kDefaultSceneSize;
 
 namespace {
 
@@ -86,27 +85,6 @@ bool samplerAvailable(const std::string& name) {
   return parseSampler(name, kind);
 }
 
-std::atomic<int> g_stopSignal{0};
-void onSignal(int sig) {
-  g_stopSignal.store(sig);
-  std::signal(sig, SIG_DFL);  // a second signal ends the program at once
-}
-
-bool validationFromEnvironment() {
-  const char* v = std::getenv("NUSSELT_VALIDATION");
-  return v && *v && std::string(v) != "0";
-}
-
-void checkOutputPath(const std::string& path, const std::string& option) {
-  namespace fs = std::filesystem;
-  fs::path p(path);
-  fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw Error(option + " " + path + ": directory " + dir.string() + " does not exist");
-  if (fs::is_directory(p, ec)) throw Error(option + " " + path + ": is a directory");
-  if (access(dir.c_str(), W_OK) != 0) throw Error(option + " " + path + ": directory " + dir.string() + " is not writable");
-}
 
 struct PreviewArgs {
   std::string scene;
@@ -722,10 +700,7 @@ int Preview::run() {
   const char** exts = glfwGetRequiredInstanceExtensions(&extCount);
   if (!exts) throw Error("no Vulkan surface extension for this display (" + glfwErrorText + "); use `nusselt render`");
 
-  LoadOptions lo;
-  lo.cameraName = a.camera;
-  m_scene = a.scene.empty() ? loadSceneFromMemory(kDefaultSceneBytes, kDefaultSceneSize, "default scene (cornell-box.glb)", lo)
-                            : loadScene(a.scene, lo);
+  m_scene = loadSceneOrDefault(a.scene, a.camera);
   if (!a.quiet) {
     for (const std::string& w : m_scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     if (m_scene.droppedTriangles)
@@ -795,8 +770,8 @@ int Preview::run() {
   }
 
   g_stopSignal = 0;
-  auto oldInt = std::signal(SIGINT, onSignal);
-  auto oldTerm = std::signal(SIGTERM, onSignal);
+  auto oldInt = std::signal(SIGINT, onStopSignal);
+  auto oldTerm = std::signal(SIGTERM, onStopSignal);
   std::size_t nextResize = 0, nextKey = 0;
   bool swapchainStale = false;
   while (!glfwWindowShouldClose(m_window) && g_stopSignal == 0) {

@@ -1,0 +1,46 @@
+#include "cli/cli_common.h"
+
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+
+#include "scene/gltf_loader.h"
+#include "util/error.h"
+
+namespace nusselt {
+extern const unsigned char kDefaultSceneBytes[];
+extern const std::size_t kDefaultSceneSize;
+
+std::atomic<int> g_stopSignal{0};
+
+void onStopSignal(int sig) {
+  g_stopSignal.store(sig);
+  std::signal(sig, SIG_DFL);  // a second signal ends the program at once
+}
+
+bool validationFromEnvironment() {
+  const char* v = std::getenv("NUSSELT_VALIDATION");
+  return v && *v && std::string(v) != "0";
+}
+
+void checkOutputPath(const std::string& path, const std::string& option) {
+  namespace fs = std::filesystem;
+  fs::path p(path);
+  fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw Error(option + " " + path + ": directory " + dir.string() + " does not exist");
+  if (fs::is_directory(p, ec)) throw Error(option + " " + path + ": is a directory");
+  if (access(dir.c_str(), W_OK) != 0) throw Error(option + " " + path + ": directory " + dir.string() + " is not writable");
+}
+
+Scene loadSceneOrDefault(const std::string& path, const std::string& camera) {
+  LoadOptions opts;
+  opts.cameraName = camera;
+  if (path.empty()) return loadSceneFromMemory(kDefaultSceneBytes, kDefaultSceneSize, "default scene (cornell-box.glb)", opts);
+  return loadScene(path, opts);
+}
+
+}  // namespace nusselt
