@@ -16,6 +16,7 @@
 #include "brdf/albedo.h"
 #include "cli/cli_common.h"
 #include "io/image.h"
+#include "quadtree/sampler_tables.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
@@ -210,6 +211,10 @@ int renderCommand(const RenderArgs& a) {
   int status = kExitOk;
   {
     auto t0 = std::chrono::steady_clock::now();
+    if (!a.quiet && s.sampler == SamplerKind::Quadtree)
+      std::fprintf(stderr, "sampler: building or loading the quadtrees of the scene's materials (cached in %s; "
+                           "a first build can take minutes for some models, see docs/sampler.md)\n",
+                   quadtree::cacheDirectory().empty() ? "no writable directory" : quadtree::cacheDirectory().c_str());
     Renderer renderer(ctx, scene, s);
     const SceneSummary& sum = renderer.summary();
     std::string models;
