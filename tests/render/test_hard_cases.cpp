@@ -54,17 +54,7 @@ std::uint32_t addMaterial(Scene& s, const Material& m) {
   return std::uint32_t(s.materials.size() - 1);
 }
 
-// Quad a b c d (counter-clockwise seen from the side its normal points to): geometric and shading
-// normal = normalize(cross(b - a, c - a)).
-void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::uint32_t material) {
-  glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
-  for (glm::vec3 p : {a, b, c, a, c, d}) {
-    s.positions.push_back(p);
-    s.normals.push_back(n);
-  }
-  s.triangleMaterial.push_back(material);
-  s.triangleMaterial.push_back(material);
-}
+using test::addQuad;
 
 // Axis-aligned box of half size h around `centre`; normals point inwards (a room) or outwards (a
 // solid). faceMaterial[k] for the faces -x, +x, -y, +y, -z, +z.

@@ -23,15 +23,7 @@ Material makeMaterial(const std::string& name, const std::string& model, const N
   return m;
 }
 
-void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::uint32_t material) {
-  glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
-  for (glm::vec3 p : {a, b, c, a, c, d}) {
-    s.positions.push_back(p);
-    s.normals.push_back(n);
-  }
-  s.triangleMaterial.push_back(material);
-  s.triangleMaterial.push_back(material);
-}
+using test::addQuad;
 
 void addSphere(Scene& s, glm::vec3 centre, float radius, std::uint32_t material, int nu = 96, int nv = 48) {
   auto p = [&](int i, int j) {

@@ -32,6 +32,16 @@ std::string sourcePath(const std::string& relative) { return std::string(NUSSELT
 
 Scene loadTestScene(const std::string& relative) { return loadScene(sourcePath(relative)); }
 
+void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::uint32_t material) {
+  glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+  for (glm::vec3 p : {a, b, c, a, c, d}) {
+    s.positions.push_back(p);
+    s.normals.push_back(n);
+  }
+  s.triangleMaterial.push_back(material);
+  s.triangleMaterial.push_back(material);
+}
+
 Rendered render(const Scene& scene, const RenderSettings& settings) {
   Renderer r(context(), scene, settings);
   for (std::uint32_t i = 0; i < settings.spp; ++i) r.renderPass();

@@ -18,6 +18,10 @@ std::uint64_t validationMessages();
 std::string sourcePath(const std::string& relative);
 Scene loadTestScene(const std::string& relative);
 
+// Appends quad a b c d (counter-clockwise seen from the side its normal points to) as two
+// triangles; geometric and shading normal = normalize(cross(b - a, c - a)).
+void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::uint32_t material);
+
 struct Rendered {
   Image image;  // with variance of the mean per channel
   RenderStats stats;
