@@ -49,7 +49,6 @@ SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint3
 SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32_t set, std::uint32_t model,
                       const BrdfParams& params, vec3 v, std::uint32_t n, std::uint32_t seed) {
   SampleBatch out;
-  VkDevice d = ctx.device;
   auto upload = [&](const void* data, std::size_t bytes, const char* what) {
     vk::Buffer b = vk::createBuffer(ctx, std::max<std::size_t>(bytes, 16), 0, false, what);
     if (bytes) vk::uploadBuffer(ctx, b, data, bytes);
@@ -80,42 +79,10 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
   g.quadNodes = nodes.address;
   g.quadLeaves = leaves.address;
 
-  // Descriptor set: binding 0 = the Globals block (as the renderer's stages).
-  VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  sl.bindingCount = 1;
-  sl.pBindings = &binding;
-  VkDescriptorSetLayout setLayout;
-  VK_CHECK(vkCreateDescriptorSetLayout(d, &sl, nullptr, &setLayout));
-  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(StageConstants)};
-  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  pl.setLayoutCount = 1;
-  pl.pSetLayouts = &setLayout;
-  pl.pushConstantRangeCount = 1;
-  pl.pPushConstantRanges = &range;
-  VkPipelineLayout layout;
-  VK_CHECK(vkCreatePipelineLayout(d, &pl, nullptr, &layout));
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1};
-  VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  dp.maxSets = 1;
-  dp.poolSizeCount = 1;
-  dp.pPoolSizes = &size;
-  VkDescriptorPool pool;
-  VK_CHECK(vkCreateDescriptorPool(d, &dp, nullptr, &pool));
-  VkDescriptorSetAllocateInfo da{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  da.descriptorPool = pool;
-  da.descriptorSetCount = 1;
-  da.pSetLayouts = &setLayout;
-  VkDescriptorSet dset;
-  VK_CHECK(vkAllocateDescriptorSets(d, &da, &dset));
-  VkDescriptorBufferInfo bi{globals.buffer, 0, VK_WHOLE_SIZE};
-  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  w.dstSet = dset;
-  w.dstBinding = 0;
-  w.descriptorCount = 1;
-  w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  w.pBufferInfo = &bi;
-  vkUpdateDescriptorSets(d, 1, &w, 0, nullptr);
+  // Binding 0 = the Globals block, as the renderer's stages.
+  vk::GlobalsBinding binding = vk::createGlobalsBinding(ctx, globals.buffer, sizeof(StageConstants));
+  VkPipelineLayout layout = binding.layout;
+  VkDescriptorSet dset = binding.set;
   vk::ComputePipeline pipe = vk::createComputePipeline(ctx, layout, "sample_tool", {model});
 
   auto t0 = std::chrono::steady_clock::now();
@@ -143,9 +110,7 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
   out.trialFailures = s[STAT_SAMPLER_TRIAL_FAILURES];
 
   vk::destroyComputePipeline(ctx, pipe);
-  vkDestroyDescriptorPool(d, pool, nullptr);
-  vkDestroyPipelineLayout(d, layout, nullptr);
-  vkDestroyDescriptorSetLayout(d, setLayout, nullptr);
+  vk::destroyGlobalsBinding(ctx, binding);
   for (vk::Buffer* b : {&materials, &sets, &tabs, &nodes, &leaves, &film, &filmSq, &stats, &globals}) vk::destroyBuffer(ctx, *b);
   return out;
 }

@@ -109,9 +109,7 @@ Renderer::~Renderer() {
   if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
   for (auto* p : {&m_camera, &m_submit, &m_intersect, &m_shadow, &m_accumulate}) vk::destroyComputePipeline(m_ctx, *p);
   for (auto& p : m_shade) vk::destroyComputePipeline(m_ctx, p);
-  if (m_descriptorPool) vkDestroyDescriptorPool(d, m_descriptorPool, nullptr);
-  if (m_pipelineLayout) vkDestroyPipelineLayout(d, m_pipelineLayout, nullptr);
-  if (m_setLayout) vkDestroyDescriptorSetLayout(d, m_setLayout, nullptr);
+  vk::destroyGlobalsBinding(m_ctx, m_binding);
   for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
   vk::destroyBuffer(m_ctx, m_globalsBuffer);
 }
@@ -384,44 +382,9 @@ void Renderer::setDisplayBuffer(VkDeviceAddress address) {
 }
 
 void Renderer::createPipelines() {
-  VkDevice d = m_ctx.device;
-  VkDescriptorSetLayoutBinding binding{};
-  binding.binding = 0;
-  binding.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  binding.descriptorCount = 1;
-  binding.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  sl.bindingCount = 1;
-  sl.pBindings = &binding;
-  VK_CHECK(vkCreateDescriptorSetLayout(d, &sl, nullptr, &m_setLayout));
-  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(StageConstants)};
-  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  pl.setLayoutCount = 1;
-  pl.pSetLayouts = &m_setLayout;
-  pl.pushConstantRangeCount = 1;
-  pl.pPushConstantRanges = &range;
-  VK_CHECK(vkCreatePipelineLayout(d, &pl, nullptr, &m_pipelineLayout));
-
-  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1};
-  VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  dp.maxSets = 1;
-  dp.poolSizeCount = 1;
-  dp.pPoolSizes = &size;
-  VK_CHECK(vkCreateDescriptorPool(d, &dp, nullptr, &m_descriptorPool));
-  VkDescriptorSetAllocateInfo da{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  da.descriptorPool = m_descriptorPool;
-  da.descriptorSetCount = 1;
-  da.pSetLayouts = &m_setLayout;
-  VK_CHECK(vkAllocateDescriptorSets(d, &da, &m_set));
-  VkDescriptorBufferInfo bi{m_globalsBuffer.buffer, 0, VK_WHOLE_SIZE};
-  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  w.dstSet = m_set;
-  w.dstBinding = 0;
-  w.descriptorCount = 1;
-  w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  w.pBufferInfo = &bi;
-  vkUpdateDescriptorSets(d, 1, &w, 0, nullptr);
-
+  m_binding = vk::createGlobalsBinding(m_ctx, m_globalsBuffer.buffer, sizeof(StageConstants));
+  m_pipelineLayout = m_binding.layout;
+  m_set = m_binding.set;
   m_camera = vk::createComputePipeline(m_ctx, m_pipelineLayout, "camera");
   m_submit = vk::createComputePipeline(m_ctx, m_pipelineLayout, "submit");
   m_intersect = vk::createComputePipeline(m_ctx, m_pipelineLayout, "intersect");

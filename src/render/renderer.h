@@ -133,10 +133,9 @@ class Renderer {
   vk::Buffer* m_args = nullptr;
   vk::Buffer* m_stats = nullptr;
 
-  VkDescriptorSetLayout m_setLayout = VK_NULL_HANDLE;
-  VkPipelineLayout m_pipelineLayout = VK_NULL_HANDLE;
-  VkDescriptorPool m_descriptorPool = VK_NULL_HANDLE;
-  VkDescriptorSet m_set = VK_NULL_HANDLE;
+  vk::GlobalsBinding m_binding;
+  VkPipelineLayout m_pipelineLayout = VK_NULL_HANDLE;  // = m_binding.layout
+  VkDescriptorSet m_set = VK_NULL_HANDLE;              // = m_binding.set
   vk::ComputePipeline m_camera, m_submit, m_intersect, m_shadow, m_accumulate;
   std::vector<vk::ComputePipeline> m_shade;  // one per slot
   VkCommandBuffer m_cmd = VK_NULL_HANDLE;

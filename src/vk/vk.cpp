@@ -478,6 +478,50 @@ void destroyComputePipeline(Context& ctx, ComputePipeline& p) {
   p.module = VK_NULL_HANDLE;
 }
 
+GlobalsBinding createGlobalsBinding(Context& ctx, VkBuffer globals, std::uint32_t pushBytes) {
+  VkDevice d = ctx.device;
+  GlobalsBinding b;
+  VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  sl.bindingCount = 1;
+  sl.pBindings = &binding;
+  VK_CHECK(vkCreateDescriptorSetLayout(d, &sl, nullptr, &b.setLayout));
+  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushBytes};
+  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  pl.setLayoutCount = 1;
+  pl.pSetLayouts = &b.setLayout;
+  pl.pushConstantRangeCount = 1;
+  pl.pPushConstantRanges = &range;
+  VK_CHECK(vkCreatePipelineLayout(d, &pl, nullptr, &b.layout));
+  VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1};
+  VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  dp.maxSets = 1;
+  dp.poolSizeCount = 1;
+  dp.pPoolSizes = &size;
+  VK_CHECK(vkCreateDescriptorPool(d, &dp, nullptr, &b.pool));
+  VkDescriptorSetAllocateInfo da{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  da.descriptorPool = b.pool;
+  da.descriptorSetCount = 1;
+  da.pSetLayouts = &b.setLayout;
+  VK_CHECK(vkAllocateDescriptorSets(d, &da, &b.set));
+  VkDescriptorBufferInfo bi{globals, 0, VK_WHOLE_SIZE};
+  VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  w.dstSet = b.set;
+  w.dstBinding = 0;
+  w.descriptorCount = 1;
+  w.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  w.pBufferInfo = &bi;
+  vkUpdateDescriptorSets(d, 1, &w, 0, nullptr);
+  return b;
+}
+
+void destroyGlobalsBinding(Context& ctx, GlobalsBinding& b) {
+  if (b.pool) vkDestroyDescriptorPool(ctx.device, b.pool, nullptr);
+  if (b.layout) vkDestroyPipelineLayout(ctx.device, b.layout, nullptr);
+  if (b.setLayout) vkDestroyDescriptorSetLayout(ctx.device, b.setLayout, nullptr);
+  b = GlobalsBinding{};
+}
+
 void computeBarrier(VkCommandBuffer cmd) {
   // Writes of one stage (path state, queue counts, dispatch args) become visible to the next
   // stage's shader reads/writes and to the indirect-dispatch read of its argument buffer.

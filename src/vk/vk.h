@@ -92,6 +92,17 @@ ComputePipeline createComputePipeline(Context& ctx, VkPipelineLayout layout, con
                                       const std::vector<std::uint32_t>& specialization = {});
 void destroyComputePipeline(Context& ctx, ComputePipeline& pipeline);
 
+// What every wavefront stage binds: one storage buffer (the Globals) at set 0, binding 0, and
+// push constants of pushBytes. Shared by the renderer and the tools that run its stages.
+struct GlobalsBinding {
+  VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+  VkPipelineLayout layout = VK_NULL_HANDLE;
+  VkDescriptorPool pool = VK_NULL_HANDLE;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+};
+GlobalsBinding createGlobalsBinding(Context& ctx, VkBuffer globals, std::uint32_t pushBytes);
+void destroyGlobalsBinding(Context& ctx, GlobalsBinding& binding);
+
 // A global memory barrier between compute dispatches, also making queue counts visible to the
 // indirect-dispatch stage that reads them.
 void computeBarrier(VkCommandBuffer cmd);
