@@ -26,10 +26,23 @@ struct QuadHost {
   const QuadLeaf* leaves = nullptr;
   std::uint64_t boundViolations = 0;  // samples during which f > M was seen in their leaf
   std::uint64_t trialFailures = 0;    // samples that hit QT_MAX_TRIALS (returned false)
-  std::uint64_t trials = 0;           // total rejection trials (statistics)
+  std::uint64_t trials = 0;           // total rejection trials (proposal draws, statistics)
+  std::uint64_t evaluations = 0;      // trials that evaluated f (inside leaf & disc)
   std::uint64_t samples = 0;          // calls of quadSample that reached a leaf
+  // Optional, per leaf (global leaf index): evaluations of f and accepted samples; the test of
+  // "every leaf accepts at least 1 / n_max of its candidates" reads them.
+  std::uint64_t* leafEvaluations = nullptr;
+  std::uint64_t* leafAccepted = nullptr;
 };
 inline thread_local QuadHost* g_quadHost = nullptr;
+inline void quadCountTrials(std::uint32_t evals, std::uint32_t trials, std::uint32_t leaf, bool accepted) {
+  QuadHost* h = g_quadHost;
+  h->trials += trials;
+  h->evaluations += evals;
+  h->samples++;
+  if (h->leafEvaluations) h->leafEvaluations[leaf] += evals;
+  if (h->leafAccepted && accepted) h->leafAccepted[leaf]++;
+}
 SHARED_END
 #define QT_SET(i) (::nusselt::shared::g_quadHost->sets[i])
 #define QT_TABLE(i) (::nusselt::shared::g_quadHost->tables[i])
@@ -37,7 +50,7 @@ SHARED_END
 #define QT_LEAF(i) (::nusselt::shared::g_quadHost->leaves[i])
 #define QT_COUNT_BOUND_VIOLATION() (::nusselt::shared::g_quadHost->boundViolations++)
 #define QT_COUNT_TRIAL_FAILURE() (::nusselt::shared::g_quadHost->trialFailures++)
-#define QT_COUNT_TRIALS(n) (::nusselt::shared::g_quadHost->trials += (n), ::nusselt::shared::g_quadHost->samples++)
+#define QT_COUNT_TRIALS(evals, n, leaf, ok) ::nusselt::shared::quadCountTrials(evals, n, leaf, ok)
 #else
 #define QT_SET(i) (g.quadSets.v[i])
 #define QT_TABLE(i) (g.quadTables.v[i])
@@ -45,7 +58,7 @@ SHARED_END
 #define QT_LEAF(i) (g.quadLeaves.v[i])
 #define QT_COUNT_BOUND_VIOLATION() atomicAdd(g.stats.v[STAT_SAMPLER_BOUND_VIOLATIONS], 1u)
 #define QT_COUNT_TRIAL_FAILURE() atomicAdd(g.stats.v[STAT_SAMPLER_TRIAL_FAILURES], 1u)
-#define QT_COUNT_TRIALS(n)
+#define QT_COUNT_TRIALS(evals, n, leaf, ok)
 #endif
 
 SHARED_BEGIN
@@ -242,19 +255,30 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, uv
     }
     if ((link & QT_LEAF_BIT) == 0u || link == QT_EMPTY) return false;
     QuadLeaf L = QT_LEAF(link & ~QT_LEAF_BIT);
-    float M = L.data.x;
     bool rim = L.data.z > 0.5f;
     float s = L.data.w;
+    // Envelope e = A + B cos^-s >= f over the leaf (B = 0 and e = A inside the disc).
+    float A = L.data.x;
+    float B = L.box.w;
 
     // Polar box of (leaf & disc) (rim proposal): cos theta in [0, coA], phi in [pa, pa + dp].
+    // Its density is proportional to e: the uniform part (A, area dp coA^2 / 2) with probability
+    // pU, the cos^-s part (B, measure dp coA^(2-s) / (2-s)) otherwise.
     float coA = L.box.x;
     float pa = L.box.y;
     float dp = L.box.z;
+    float wU = A * coA * coA * 0.5f;
+    float wS = B > 0.0f ? B * pow(coA, 2.0f - s) / (2.0f - s) : 0.0f;
+    float pU = wU / (wU + wS);
 
     // ---- Rejection in the same leaf (restarting at the root would break proportionality) ----
+    // A trial draws a point from the proposal (uniform square, or the polar box with density
+    // proportional to e); points outside (leaf & disc) are discarded before f is evaluated; the
+    // others are accepted with probability f / e.
     bool accepted = false;
     bool violated = false;
     uint trial = 0u;
+    uint evaluations = 0u;
     float fl = 0.0f;
     // Rejection numbers: a second hash of the hashed key. One hash of a key that differs from the
     // caller's (descent) key in one component only is strongly correlated with it (pcg4d mixes the
@@ -265,31 +289,33 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, uv
       float a = float(h.x >> 8u) * (1.0f / 16777216.0f);
       float b = float(h.y >> 8u) * (1.0f / 16777216.0f);
       float cc = float(h.z >> 8u) * (1.0f / 16777216.0f);
-      float x, y, co, weight;
+      float x, y, co, e;
       if (rim) {
-        co = coA * pow(a, 1.0f / (2.0f - s));
+        float cm = float(h.w >> 8u) * (1.0f / 16777216.0f);
+        co = cm < pU ? coA * sqrt(a) : coA * pow(a, 1.0f / (2.0f - s));
+        if (co <= 0.0f) continue;
         float r = cosFromSin(co);
         float ph = pa + b * dp;
         x = r * cos(ph);
         y = r * sin(ph);
         if (x < x0 || x > x1 || y < y0 || y > y1) continue;
-        weight = pow(co, s);
+        e = B > 0.0f ? A + B * pow(co, -s) : A;
       } else {
         x = mix(x0, x1, a);
         y = mix(y0, y1, b);
         float r2 = x * x + y * y;
         if (r2 >= 1.0f) continue;
         co = cosFromSin(sqrt(r2));
-        weight = 1.0f;
+        e = A;
       }
       if (co <= 0.0f) continue;
       wc = vec3(x, y, co);
       fl = quadEvalLum(model, p, wc, vk);
-      float g = fl * weight;
-      if (g > M) violated = true;
-      if (cc * M < g) { accepted = true; break; }
+      ++evaluations;
+      if (fl > e) violated = true;
+      if (cc * e < fl) { accepted = true; break; }
     }
-    QT_COUNT_TRIALS(trial + 1u);
+    QT_COUNT_TRIALS(evaluations, trial + 1u, link & ~QT_LEAF_BIT, accepted);
     if (violated) QT_COUNT_BOUND_VIOLATION();
     if (!accepted) {
       QT_COUNT_TRIAL_FAILURE();

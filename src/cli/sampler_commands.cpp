@@ -39,6 +39,7 @@ struct SampleArgs {
   std::uint32_t seed = 0;
   int device = -1;
   std::uint32_t thetaTables = 90;
+  std::uint32_t phiTables = 16;
 };
 
 BrdfParams paramsFor(const ModelSpec& m, const std::string& preset, const std::vector<std::string>& extra) {
@@ -107,6 +108,7 @@ int sampleCommand(const SampleArgs& a) {
   BrdfParams p = paramsFor(m, a.preset, a.params);
   quadtree::QuadtreeSettings qs;
   qs.thetaTables = a.thetaTables;
+  qs.phiTables = a.phiTables;
   std::vector<std::uint32_t> setIndex;
   quadtree::SamplerTables tables = quadtree::buildSamplerTables({{m.id, p}}, qs, setIndex);
   double th = a.thetaDeg * M_PI / 180, ph = a.phiDeg * M_PI / 180;
@@ -163,6 +165,7 @@ struct BenchArgs {
   std::vector<std::string> models;
   std::string preset = "typical";
   std::uint32_t thetaTables = 90;
+  std::uint32_t phiTables = 16;
   unsigned threads = 0;
 };
 
@@ -172,8 +175,8 @@ int benchPrecompute(const BenchArgs& a) {
       {"htsg", 102.7}, {"lafortune", 6.6}, {"lewis", 6.9}, {"minnaert", 7.3}, {"oren_nayar", 10.5},
       {"phong", 6.9}, {"poulin_fournier", 35.5}, {"schlick", 13.2}, {"strauss", 10.9},
       {"torrance_sparrow", 8.3}, {"ward", 20.7}};
-  std::printf("# nusselt bench precompute: %s parameters, %u theta tables (x16 phi tables when anisotropic), cache off, %u threads\n",
-              a.preset.c_str(), a.thetaTables, a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency()));
+  std::printf("# nusselt bench precompute: %s parameters, %u theta tables (x%u phi tables when anisotropic), cache off, %u threads\n",
+              a.preset.c_str(), a.thetaTables, a.phiTables, a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency()));
   std::printf("%-18s %5s %9s %9s %9s %10s %7s %7s %6s %8s %9s\n", "model", "trees", "wall_s", "nodes", "leaves", "KiB",
               "capped", "rim", "depth", "minAcc", "paper_s");
   double sum = 0;
@@ -185,6 +188,7 @@ int benchPrecompute(const BenchArgs& a) {
     quadtree::QuadtreeSettings qs;
     qs.useCache = false;
     qs.thetaTables = a.thetaTables;
+    qs.phiTables = a.phiTables;
     qs.threads = a.threads;
     std::vector<std::uint32_t> idx;
     quadtree::SamplerTables t = quadtree::buildSamplerTables({{m.id, p}}, qs, idx);
@@ -219,6 +223,7 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
   sample->add_option("--seed", sa->seed, "Seed")->capture_default_str();
   sample->add_option("--device", sa->device, "Vulkan device index");
   sample->add_option("--theta-tables", sa->thetaTables, "Tables along theta")->capture_default_str()->check(CLI::Range(1u, 4096u));
+  sample->add_option("--phi-tables", sa->phiTables, "Tables along phi (anisotropic models)")->capture_default_str()->check(CLI::Range(2u, 1024u));
   sample->callback([sa, &run]() { run = [sa]() { return sampleCommand(*sa); }; });
 
   auto ba = std::make_shared<BenchArgs>();
@@ -226,6 +231,7 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
   pre->add_option("--model", ba->models, "Only these models (repeatable)");
   pre->add_option("--preset", ba->preset, "typical (default) or hard")->check(CLI::IsMember({"typical", "hard"}));
   pre->add_option("--theta-tables", ba->thetaTables, "Tables along theta")->capture_default_str()->check(CLI::Range(1u, 4096u));
+  pre->add_option("--phi-tables", ba->phiTables, "Tables along phi (anisotropic models)")->capture_default_str()->check(CLI::Range(2u, 1024u));
   pre->add_option("--threads", ba->threads, "Build threads (0: all cores)")->capture_default_str();
   pre->callback([ba, &run]() { run = [ba]() { return benchPrecompute(*ba); }; });
 }

@@ -20,9 +20,12 @@ SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint3
   out.wPdf.assign(n, vec4(0.0f));
   out.fOk.assign(n, vec4(0.0f));
   unsigned nt = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
-  std::atomic<std::uint64_t> viol{0}, fail{0}, trials{0};
+  std::atomic<std::uint64_t> viol{0}, fail{0}, trials{0}, evals{0};
+  std::vector<std::vector<std::uint64_t>> leafEval(nt, std::vector<std::uint64_t>(tables.leaves.size(), 0)),
+      leafAcc(nt, std::vector<std::uint64_t>(tables.leaves.size(), 0));
   auto work = [&](unsigned t) {
     QuadHostScope scope(tables);
+    scope.countPerLeaf(leafEval[t].data(), leafAcc[t].data());
     for (std::uint32_t i = t; i < n; i += nt) {
       vec2 u = rng2(i, 0u, RNG_DIM_BSDF, seed);
       vec3 w, f;
@@ -34,6 +37,7 @@ SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint3
     viol += scope.counters().boundViolations;
     fail += scope.counters().trialFailures;
     trials += scope.counters().trials;
+    evals += scope.counters().evaluations;
   };
   std::vector<std::thread> pool;
   for (unsigned t = 1; t < nt; ++t) pool.emplace_back(work, t);
@@ -42,6 +46,14 @@ SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint3
   out.boundViolations = viol;
   out.trialFailures = fail;
   out.trials = trials;
+  out.evaluations = evals;
+  out.leafEvaluations.assign(tables.leaves.size(), 0);
+  out.leafAccepted.assign(tables.leaves.size(), 0);
+  for (unsigned t = 0; t < nt; ++t)
+    for (std::size_t l = 0; l < tables.leaves.size(); ++l) {
+      out.leafEvaluations[l] += leafEval[t][l];
+      out.leafAccepted[l] += leafAcc[t][l];
+    }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

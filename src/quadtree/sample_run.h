@@ -14,7 +14,9 @@ struct SampleBatch {
   std::vector<shared::vec4> wPdf;  // direction (local frame), pdf per unit solid angle (0: failed)
   std::vector<shared::vec4> fOk;   // f rgb, 1 if the sample succeeded
   std::uint64_t boundViolations = 0, trialFailures = 0;
-  std::uint64_t trials = 0;        // CPU only: rejection trials in total
+  std::uint64_t trials = 0;        // CPU only: rejection trials in total (proposal draws)
+  std::uint64_t evaluations = 0;   // CPU only: trials that evaluated f (inside leaf & disc)
+  std::vector<std::uint64_t> leafEvaluations, leafAccepted;  // CPU only: per leaf of `tables`
   double seconds = 0;
 };
 

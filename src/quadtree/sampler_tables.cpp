@@ -24,7 +24,7 @@ using namespace shared;
 namespace {
 
 // Bump when the tree format or the build algorithm changes: old cache entries become stale.
-constexpr std::uint32_t kFormatVersion = 4;  // 4: strauss rim exponent
+constexpr std::uint32_t kFormatVersion = 5;  // 5: rim envelope A + B cos^-s on (cell & disc)
 constexpr char kMagic[8] = {'N', 'U', 'S', 'Q', 'T', 'R', 'E', 'E'};
 
 std::uint64_t fnv1a(const void* data, std::size_t n, std::uint64_t h = 1469598103934665603ull) {

@@ -64,6 +64,11 @@ class QuadHostScope {
   QuadHostScope(const QuadHostScope&) = delete;
   QuadHostScope& operator=(const QuadHostScope&) = delete;
   const shared::QuadHost& counters() const { return m_host; }
+  // Per-leaf counters (arrays of tables.leaves.size(), owned by the caller), or nullptr.
+  void countPerLeaf(std::uint64_t* evaluations, std::uint64_t* accepted) {
+    m_host.leafEvaluations = evaluations;
+    m_host.leafAccepted = accepted;
+  }
 
  private:
   shared::QuadHost m_host;
