@@ -170,6 +170,9 @@ int renderCommand(const RenderArgs& a) {
   s.lighting = parseLighting(a.lighting);
   s.rng = a.rng == "qmc" ? RngMode::Qmc : RngMode::Pcg;
   parseSampler(a.sampler, s.sampler);
+  if (s.sampler == SamplerKind::Tabulated)
+    throw Error("--sampler tabulated: not available in renders yet (its tables are not wired into the renderer's "
+                "buffers); it works in `nusselt sample --sampler tabulated --cpu`");
   // Image size: defaults follow the camera's aspect ratio when only one side (or none) is given.
   float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
   s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u);
@@ -602,8 +605,9 @@ int runCli(int argc, char** argv) {
                                                    "into disjoint ranges and combine them with `nusselt merge`")
       ->capture_default_str();
   render->add_option("--sampler", ra.sampler, "BSDF sampling of non-delta models: quadtree (the generic sampler: "
-                                              "density proportional to BRDF x cos for any model), cosine, uniform")
-      ->capture_default_str()->check(CLI::IsMember({"quadtree", "cosine", "uniform"}));
+                                              "density proportional to BRDF x cos for any model), cosine, uniform, analytic (the model's "
+                                              "own importance sampling, cosine where it has none), tabulated")
+      ->capture_default_str()->check(CLI::IsMember({"quadtree", "cosine", "uniform", "analytic", "tabulated"}));
   render->add_option("--rng", ra.rng, "Random numbers: pcg (independent hashes) or qmc (padded Owen-scrambled Sobol)")
       ->capture_default_str()->check(CLI::IsMember({"pcg", "qmc"}));
   render->add_option("--checkpoint", ra.checkpointSeconds, "Write the image so far to the output every this many seconds "
