@@ -176,6 +176,9 @@ int renderCommand(const RenderArgs& a) {
   s.rng = a.rng == "qmc" ? RngMode::Qmc : RngMode::Pcg;
   parseSampler(a.sampler, s.sampler);
   parseComponentSelection(a.components, s.components);
+  if (s.sampler == SamplerKind::Tabulated)
+    throw Error("--sampler tabulated: not available in renders yet (its tables are not wired into the renderer's "
+                "buffers); it works in `nusselt sample --sampler tabulated --cpu`");
   // Image size: defaults follow the camera's aspect ratio when only one side (or none) is given.
   float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
   s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u);
@@ -611,8 +614,9 @@ int runCli(int argc, char** argv) {
                                                    "into disjoint ranges and combine them with `nusselt merge`")
       ->capture_default_str();
   render->add_option("--sampler", ra.sampler, "BSDF sampling of non-delta models: quadtree (the generic sampler: "
-                                              "density proportional to BRDF x cos for any model), cosine, uniform")
-      ->capture_default_str()->check(CLI::IsMember({"quadtree", "cosine", "uniform"}));
+                                              "density proportional to BRDF x cos for any model), cosine, uniform, analytic (the model's "
+                                              "own importance sampling, cosine where it has none), tabulated")
+      ->capture_default_str()->check(CLI::IsMember({"quadtree", "cosine", "uniform", "analytic", "tabulated"}));
   render->add_option("--components", ra.components, "Component choice of combined materials: albedo (probability = "
                                                     "the component's albedo for the current direction, the rest ends "
                                                     "the walk: the random-walk source's estimator) or uniform "

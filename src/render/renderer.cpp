@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <thread>
@@ -39,6 +40,8 @@ const char* samplerName(SamplerKind kind) {
     case SamplerKind::Quadtree: return "quadtree";
     case SamplerKind::Cosine: return "cosine";
     case SamplerKind::Uniform: return "uniform";
+    case SamplerKind::Analytic: return "analytic";
+    case SamplerKind::Tabulated: return "tabulated";
   }
   return "?";
 }
@@ -57,7 +60,8 @@ bool parseComponentSelection(const std::string& name, ComponentSelection& mode) 
 }
 
 bool parseSampler(const std::string& name, SamplerKind& kind) {
-  for (SamplerKind k : {SamplerKind::Quadtree, SamplerKind::Cosine, SamplerKind::Uniform})
+  for (SamplerKind k : {SamplerKind::Quadtree, SamplerKind::Cosine, SamplerKind::Uniform, SamplerKind::Analytic,
+                        SamplerKind::Tabulated})
     if (name == samplerName(k)) {
       kind = k;
       return true;
@@ -84,6 +88,13 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   if (settings.width == 0 || settings.height == 0) throw Error("image size must be at least 1x1");
   std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;
   if (pixels > (1ull << 28)) throw Error("image too large: at most 2^28 pixels");
+  // TODO(issue 5): the tabulated strategy's tables have no GPU buffers yet (the wiring steps are in
+  // shaders/shared/bsdf_sampling.h); until then a render that asks for it samples with cosine.
+  if (m_settings.sampler == SamplerKind::Tabulated) {
+    std::fprintf(stderr, "error: sampler tabulated is not wired into the renderer yet (its tables have no GPU "
+                         "buffers): rendering with cosine sampling instead\n");
+    m_settings.sampler = SamplerKind::Cosine;
+  }
   // One indirect dispatch covers a whole queue: its group count must stay <= 65535.
   std::uint32_t maxChunk = std::min<std::uint32_t>(settings.maxPathsPerChunk, 65535u * WORKGROUP_SIZE);
   m_capacity = static_cast<std::uint32_t>(std::min<std::uint64_t>(pixels, maxChunk));

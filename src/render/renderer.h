@@ -16,7 +16,7 @@ namespace nusselt {
 enum class LightingMode : std::uint32_t { Mis = 0, NeeOnly = 1, BsdfOnly = 2 };
 const char* lightingModeName(LightingMode mode);
 // BSDF sampling strategy for non-delta models (SAMPLER_* in shaders/shared/bsdf_sampling.h).
-enum class SamplerKind : std::uint32_t { Quadtree = 0, Cosine = 1, Uniform = 2 };
+enum class SamplerKind : std::uint32_t { Quadtree = 0, Cosine = 1, Uniform = 2, Analytic = 3, Tabulated = 4 };
 const char* samplerName(SamplerKind kind);
 // nullptr-safe parse: returns false for an unknown name.
 bool parseSampler(const std::string& name, SamplerKind& kind);
