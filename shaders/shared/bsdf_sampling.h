@@ -12,22 +12,58 @@
 //             f cos, for any model; continuation = the tabulated directional albedo
 //   cosine    cosine-weighted hemisphere (the random-walk source's diffuse sampling)
 //   uniform   uniform hemisphere
+//   analytic  the model's own importance sampling where one exists, cosine elsewhere
+//             (analytic_sampling.h); continuation = min(1, luminance of the weight)
+//   tabulated piecewise-constant tables per incident angle with inverse-CDF sampling
+//             (tabulated.h); continuation = the table's directional albedo
 // All return the true density of their samples, so all are unbiased. Delta models (mirror,
 // dielectric) are always sampled analytically.
+//
+// The set argument `quadSet` is the table set of the active strategy: the QuadSet for quadtree,
+// the TabSet for tabulated (the renderer stores the one of the strategy it renders with in
+// GpuMaterial.info.z); INVALID_INDEX (no tables) falls back to cosine.
+//
+// TODO(issue 5, renderer wiring of `tabulated`): the GLSL side compiles the tabulated strategy only
+// when NUSSELT_TABULATED_BUFFERS is defined; without it SAMPLER_TABULATED is cosine on the GPU.
+// To wire it: in layout.h
+//   1. #include "tabulated_layout.h" beside quadtree_layout.h;
+//   2. in the GLSL buffer_reference block:
+//        layout(buffer_reference, std430, buffer_reference_align = 16) buffer TabSets { TabSet v[]; };
+//        layout(buffer_reference, std430, buffer_reference_align = 16) buffer TabTables { TabTable v[]; };
+//   3. in Globals (after quadLeaves): BUFREF(TabSets) tabSets; BUFREF(TabTables) tabTables;
+//      BUFREF(Floats) tabData;  and the size assert 25 * 8 -> 28 * 8;
+//   4. #define NUSSELT_TABULATED_BUFFERS (e.g. right after the Globals struct);
+// in renderer.cpp: when settings.sampler == Tabulated, build
+// sampling::buildTabulatedTables(<the used non-delta materials>, TabulatedSettings{}, setOf)
+// (src/sampling/tabulated.h), store setOf[k] in materials[...].info.z, upload sets/tables/data
+// (never empty: the builder returns one dummy entry each) and set g.tabSets/tabTables/tabData;
+// then drop the fallback in Renderer::Renderer.
 #ifndef NUSSELT_BSDF_SAMPLING_H
 #define NUSSELT_BSDF_SAMPLING_H
 #include "brdf/dispatch.h"
+#include "analytic_sampling.h"
 #include "quadtree.h"
 #include "warp.h"
+#if defined(__cplusplus) || defined(NUSSELT_TABULATED_BUFFERS)
+#include "tabulated.h"
+#define NUSSELT_HAS_TABULATED 1
+#endif
 SHARED_BEGIN
 
 #define SAMPLER_QUADTREE 0u
 #define SAMPLER_COSINE 1u
 #define SAMPLER_UNIFORM 2u
+#define SAMPLER_ANALYTIC 3u
+#define SAMPLER_TABULATED 4u
 
-// The quadtree sampler needs the material's QuadSet; without one it falls back to cosine.
+// The quadtree and tabulated samplers need the material's table set; without one they fall back
+// to cosine (so does tabulated in GLSL until its buffers exist: see the TODO above).
 SHARED_FN uint effectiveSampler(uint strategy, uint quadSet) {
-  return (strategy == SAMPLER_QUADTREE && quadSet == INVALID_INDEX) ? SAMPLER_COSINE : strategy;
+#ifndef NUSSELT_HAS_TABULATED
+  if (strategy == SAMPLER_TABULATED) return SAMPLER_COSINE;
+#endif
+  return ((strategy == SAMPLER_QUADTREE || strategy == SAMPLER_TABULATED) && quadSet == INVALID_INDEX) ? SAMPLER_COSINE
+                                                                                                      : strategy;
 }
 
 SHARED_FN float bsdfPdf(uint strategy, uint model, uint quadSet, BrdfParams p, vec3 wo, vec3 wi) {
@@ -35,6 +71,10 @@ SHARED_FN float bsdfPdf(uint strategy, uint model, uint quadSet, BrdfParams p, v
   uint s = effectiveSampler(strategy, quadSet);
   if (s == SAMPLER_QUADTREE) return quadPdf(quadSet, model, p, wo, wi);
   if (s == SAMPLER_UNIFORM) return 0.5f * NUSSELT_INV_PI;
+  if (s == SAMPLER_ANALYTIC) return analyticPdf(model, p, wo, wi);
+#ifdef NUSSELT_HAS_TABULATED
+  if (s == SAMPLER_TABULATED) return tabPdf(quadSet, wo, wi);
+#endif
   return cosineHemispherePdf(wi);
 }
 
@@ -84,7 +124,16 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
     continuation = min(1.0f, quadAlbedo(quadSet, wo.z, portableAtan2(wo.y, wo.x)));
     return true;
   }
-  if (s == SAMPLER_UNIFORM) {
+  float cont = -1.0f;  // < 0: min(1, luminance(weight))
+  if (s == SAMPLER_ANALYTIC) {
+    if (!analyticSample(model, p, wo, u, wi, pdf)) return false;
+#ifdef NUSSELT_HAS_TABULATED
+  } else if (s == SAMPLER_TABULATED) {
+    if (!tabSample(quadSet, wo, u, wi, pdf)) return false;
+    float a = tabAlbedo(quadSet, wo);
+    if (a > 0.0f) cont = min(1.0f, a);
+#endif
+  } else if (s == SAMPLER_UNIFORM) {
     float z = u.x;
     float r = cosFromSin(z);
     float phi = NUSSELT_TWO_PI * u.y;
@@ -97,7 +146,7 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
   if (!(pdf > 0.0f) || wi.z <= 0.0f) return false;
   weight = brdfEval(model, p, wi, wo) * (wi.z / pdf);
   // Without a tabulated albedo, the sample weight's luminance (its estimate) is the continuation.
-  continuation = min(1.0f, luminance(weight));
+  continuation = cont >= 0.0f ? cont : min(1.0f, luminance(weight));
   return true;
 }
 

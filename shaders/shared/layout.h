@@ -51,7 +51,20 @@ SHARED_BEGIN
 
 // ---- Material flags ---------------------------------------------------------------------------------
 #define MATERIAL_EMISSIVE 1u
-#define MATERIAL_DELTA 2u
+#define MATERIAL_DELTA 2u     // every component of the material is a delta model (no light samples)
+#define MATERIAL_COMBINED 4u  // a weighted sum of elementary BRDFs (GpuMaterial.components)
+
+// ---- Combined materials ---------------------------------------------------------------------------
+// At most this many components per material: the shade stage is specialised per tuple of component
+// models (spec constants MODEL_0..MODEL_3), and every component's code is in its kernel.
+#define MAX_COMPONENTS 4u
+// Component choice (Globals.options.y): albedo = the random-walk source's estimator (choose k with
+// probability = its albedo for wo; the choice includes the roulette); uniform = choose k with
+// probability 1/n and play a separate albedo roulette (for the speed-versus-error comparison).
+#define COMPONENTS_ALBEDO 0u
+#define COMPONENTS_UNIFORM 1u
+// Nodes of a component's tabulated albedo estimate (GpuComponent.albedo): cos theta_o = i / 7.
+#define COMPONENT_ALBEDO_NODES 8u
 
 // Invalid index marker.
 #define INVALID_INDEX 0xffffffffu
@@ -99,12 +112,29 @@ STATIC_ASSERT_SIZE(BrdfParams, 128);
 
 // info = (model id, MATERIAL_* flags, quadtree set index (QuadSet) or INVALID_INDEX, shade slot).
 // emission = emitted radiance (rgb), w unused.
+// components = (first GpuComponent, count, 0, 0) when MATERIAL_COMBINED (then info.x is the first
+// component's model and params/info.z are unused); (0, 0, 0, 0) otherwise.
 struct GpuMaterial {
   uvec4 info;
   vec4 emission;
   BrdfParams params;
+  uvec4 components;
 };
-STATIC_ASSERT_SIZE(GpuMaterial, 160);
+STATIC_ASSERT_SIZE(GpuMaterial, 176);
+
+// One term w * f_k of a combined material (shaders/shared/combined.h).
+// info = (model id, quadtree set index or INVALID_INDEX, 0, 0); data = (weight w, 0, 0, 0);
+// albedoLo, albedoHi = the component's directional albedo (luminance, without w) at cos theta_o =
+// i / 7, i = 0..3 in albedoLo and 4..7 in albedoHi, computed on the CPU for components that have no QuadSet (their
+// choice probability must be known before sampling; quadtree components use quadAlbedo).
+struct GpuComponent {
+  uvec4 info;
+  vec4 data;
+  vec4 albedoLo;
+  vec4 albedoHi;
+  BrdfParams params;
+};
+STATIC_ASSERT_SIZE(GpuComponent, 192);
 
 // A light. Triangle emitters: info = (LIGHT_TRIANGLE, triangle index, 0, 0), radiance from the
 // material. Punctual lights (KHR_lights_punctual): position (w unused), direction the light
@@ -134,6 +164,7 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer BvhNodes { 
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Triangles { GpuTriangle v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer TriShadings { GpuTriShading v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Materials { GpuMaterial v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Components { GpuComponent v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Lights { GpuLight v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Vec4s { vec4 v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer UVec4s { uvec4 v[]; };
@@ -151,7 +182,7 @@ struct Globals {
   uvec4 image;      // width, height, first pixel of this chunk, pixels in this chunk
   uvec4 frame;      // sample index of this pass, seed, max depth, path capacity
   uvec4 counts;     // materials, lights, triangles, lighting mode (LIGHTING_*)
-  uvec4 options;    // random numbers (RNG_PCG / RNG_QMC), 0, 0, 0
+  uvec4 options;    // random numbers (RNG_PCG / RNG_QMC), component choice (COMPONENTS_*), 0, 0
   vec4 camPosition; // xyz, w = 1 for orthographic
   vec4 camRight;    // unit right * (tan(yfov/2) * aspect), or * xmag for orthographic
   vec4 camUp;       // unit up * tan(yfov/2), or * ymag for orthographic
@@ -185,8 +216,9 @@ struct Globals {
   BUFREF(QuadNodes) quadNodes;
   BUFREF(QuadLeaves) quadLeaves;
   BUFREF(Uints) display;       // the preview's RGBA8 display buffer (0 when headless)
+  BUFREF(Components) components; // the components of combined materials (GpuMaterial.components)
 };
-STATIC_ASSERT_SIZE(Globals, 64 + 7 * 16 + 25 * 8);
+STATIC_ASSERT_SIZE(Globals, 64 + 7 * 16 + 26 * 8);
 
 // Push constants of every stage.
 struct StageConstants {

@@ -2,8 +2,9 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_scalar_block_layout : require
-// sample_tool: draws directions with the generic (quadtree) sampler for `nusselt sample` and the
-// GPU tests. MODEL_ID is a specialization constant (one model per pipeline, as in shade).
+// sample_tool: draws directions with a BSDF sampling strategy for `nusselt sample` and the GPU
+// tests. MODEL_ID and SAMPLER (SAMPLER_QUADTREE, _COSINE, _UNIFORM or _ANALYTIC; tabulated has no
+// GPU buffers yet) are specialization constants (one model and strategy per pipeline, as in shade).
 // Inputs in Globals: image.x = samples in this dispatch, image.y = index of the first one,
 // frame.y = seed, camForward.xyz = the known direction v (local frame), materials.v[0] = the
 // material (info.z = its QuadSet). Outputs per sample i: film.v[i] = (w, pdf or 0 on failure),
@@ -11,10 +12,11 @@
 // failures). Sample i uses rng2(i, 0, RNG_DIM_BSDF, seed) and the rejection stream of
 // (i, 0, RNG_DIM_BSDF, seed): the CPU reproduces it bit for bit up to float differences.
 #include "shared/layout.h"
-#include "shared/quadtree.h"
+#include "shared/bsdf_sampling.h"
 
 layout(local_size_x = WORKGROUP_SIZE) in;
 layout(constant_id = 0) const uint MODEL_ID = 0u;
+layout(constant_id = 1) const uint SAMPLER = SAMPLER_QUADTREE;
 
 void main() {
   uint local = gl_GlobalInvocationID.x;
@@ -24,10 +26,28 @@ void main() {
   vec3 v = g.camForward.xyz;
   uint seed = g.frame.y;
   vec2 u = rng2(i, 0u, RNG_DIM_BSDF, seed);
-  vec3 w;
-  float pdf;
-  vec3 f;
-  bool ok = quadSample(M.info.z, MODEL_ID, M.params, v, u, uvec4(i, 0u, RNG_DIM_BSDF, seed), w, pdf, f);
+  vec3 w = vec3(0.0f);
+  float pdf = 0.0f;
+  vec3 f = vec3(0.0f);
+  bool ok = false;
+  if (SAMPLER == SAMPLER_QUADTREE) {
+    ok = quadSample(M.info.z, MODEL_ID, M.params, v, u, uvec4(i, 0u, RNG_DIM_BSDF, seed), w, pdf, f);
+  } else {
+    if (SAMPLER == SAMPLER_ANALYTIC) {
+      ok = analyticSample(MODEL_ID, M.params, v, u, w, pdf);
+    } else if (SAMPLER == SAMPLER_UNIFORM) {
+      float r = cosFromSin(u.x);
+      float phi = NUSSELT_TWO_PI * u.y;
+      w = vec3(r * cos(phi), r * sin(phi), u.x);
+      pdf = 0.5f * NUSSELT_INV_PI;
+      ok = w.z > 0.0f;
+    } else {
+      w = squareToCosineHemisphere(u);
+      pdf = cosineHemispherePdf(w);
+      ok = w.z > 0.0f && pdf > 0.0f;
+    }
+    if (ok) f = brdfEval(MODEL_ID, M.params, w, v);
+  }
   g.film.v[i] = vec4(w, ok ? pdf : 0.0f);
   g.filmSq.v[i] = vec4(f, ok ? 1.0f : 0.0f);
 }

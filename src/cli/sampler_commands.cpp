@@ -18,6 +18,7 @@
 #include "cli/commands.h"
 #include "quadtree/sample_run.h"
 #include "quadtree/sampler_tables.h"
+#include "sampling/tabulated.h"
 #include "util/error.h"
 #include "vk/vk.h"
 
@@ -40,7 +41,17 @@ struct SampleArgs {
   int device = -1;
   std::uint32_t thetaTables = 90;
   std::uint32_t phiTables = 16;
+  std::string sampler = "quadtree";
+  std::uint64_t tabBytes = 64 * 1024;
 };
+
+std::uint32_t strategyId(const std::string& name) {
+  if (name == "cosine") return SAMPLER_COSINE;
+  if (name == "uniform") return SAMPLER_UNIFORM;
+  if (name == "analytic") return SAMPLER_ANALYTIC;
+  if (name == "tabulated") return SAMPLER_TABULATED;
+  return SAMPLER_QUADTREE;
+}
 
 BrdfParams paramsFor(const ModelSpec& m, const std::string& preset, const std::vector<std::string>& extra) {
   NamedParams values = preset == "hard" ? hardParams(m) : typicalParams(m);
@@ -61,7 +72,7 @@ const ModelSpec& modelOrThrow(const std::string& name) {
     for (const ModelSpec& s : allModels()) list += (list.empty() ? "" : ", ") + s.name;
     throw Error("--model " + name + ": unknown model (one of " + list + ")");
   }
-  if (m->delta) throw Error("--model " + name + ": a delta model has no quadtree (it is sampled analytically)");
+  if (m->delta) throw Error("--model " + name + ": a delta model is always sampled analytically (no strategy applies)");
   return *m;
 }
 
@@ -106,17 +117,37 @@ int sampleCommand(const SampleArgs& a) {
   const ModelSpec& m = modelOrThrow(a.model);
   if (a.thetaDeg < 0 || a.thetaDeg >= 90) throw Error("--theta must lie in [0, 90)");
   BrdfParams p = paramsFor(m, a.preset, a.params);
-  quadtree::QuadtreeSettings qs;
-  qs.thetaTables = a.thetaTables;
-  qs.phiTables = a.phiTables;
-  std::vector<std::uint32_t> setIndex;
-  quadtree::SamplerTables tables = quadtree::buildSamplerTables({{m.id, p}}, qs, setIndex);
+  const std::uint32_t strategy = strategyId(a.sampler);
+  if (strategy == SAMPLER_TABULATED && !a.cpu)
+    throw Error("--sampler tabulated: its tables have no GPU buffers yet; add --cpu");
+  if (strategy != SAMPLER_QUADTREE && !a.svg.empty()) throw Error("--svg draws the quadtree: only with --sampler quadtree");
   double th = a.thetaDeg * M_PI / 180, ph = a.phiDeg * M_PI / 180;
   vec3 v(float(std::sin(th) * std::cos(ph)), float(std::sin(th) * std::sin(ph)), float(std::cos(th)));
+  std::vector<std::uint32_t> setIndex{INVALID_INDEX};
+  quadtree::SamplerTables tables;
+  sampling::TabulatedTables tab;
+  if (strategy == SAMPLER_QUADTREE) {
+    quadtree::QuadtreeSettings qs;
+    qs.thetaTables = a.thetaTables;
+    qs.phiTables = a.phiTables;
+    tables = quadtree::buildSamplerTables({{m.id, p}}, qs, setIndex);
+  } else if (strategy == SAMPLER_TABULATED) {
+    sampling::TabulatedSettings ts;
+    ts.thetaTables = a.thetaTables;
+    ts.bytesPerTable = a.tabBytes;
+    // Only the theta tables the known direction uses (the nearest one).
+    ts.onlyThetaTables = {std::min<std::uint32_t>(std::uint32_t(std::lround(th / (0.5 * M_PI / a.thetaTables))),
+                                                  a.thetaTables - 1)};
+    tab = sampling::buildTabulatedTables({{m.id, p}}, ts, setIndex);
+  }
   quadtree::SampleBatch b;
   std::string where;
-  if (a.cpu) {
+  if (a.cpu && strategy == SAMPLER_QUADTREE) {
     b = quadtree::sampleCpu(tables, setIndex[0], m.id, p, v, a.n, a.seed);
+    where = "cpu";
+  } else if (a.cpu) {
+    b = quadtree::sampleCpuStrategy(strategy, strategy == SAMPLER_TABULATED ? &tab : nullptr, setIndex[0], m.id, p, v,
+                                    a.n, a.seed);
     where = "cpu";
   } else {
     vk::Context ctx;
@@ -124,7 +155,7 @@ int sampleCommand(const SampleArgs& a) {
     opts.deviceIndex = a.device;
     vk::createContext(ctx, opts);
     try {
-      b = quadtree::sampleGpu(ctx, tables, setIndex[0], m.id, p, v, a.n, a.seed);
+      b = quadtree::sampleGpu(ctx, tables, setIndex[0], m.id, p, v, a.n, a.seed, strategy);
     } catch (...) {
       vk::destroyContext(ctx);
       throw;
@@ -142,10 +173,22 @@ int sampleCommand(const SampleArgs& a) {
     std::fprintf(f, "%.9g,%.9g,%.9g,%.9g,%.9g\n", w.x, w.y, w.z, w.w, luminance(vec3(b.fOk[i])));
   }
   std::fclose(f);
-  const quadtree::MaterialStats& st = tables.materials[0];
-  std::printf("%s: %u samples on %s in %.3f s; trees: %u (%s, %.3f s), %u nodes, %u leaves, %.1f KiB\n", m.name.c_str(), a.n,
-              where.c_str(), b.seconds, st.trees, st.cacheHit ? "cache" : "built", tables.seconds, st.nodes, st.leaves,
-              st.bytes / 1024.0);
+  if (strategy == SAMPLER_QUADTREE) {
+    const quadtree::MaterialStats& st = tables.materials[0];
+    std::printf("%s: %u samples on %s in %.3f s; trees: %u (%s, %.3f s), %u nodes, %u leaves, %.1f KiB\n", m.name.c_str(),
+                a.n, where.c_str(), b.seconds, st.trees, st.cacheHit ? "cache" : "built", tables.seconds, st.nodes,
+                st.leaves, st.bytes / 1024.0);
+  } else if (strategy == SAMPLER_TABULATED) {
+    const TabSet& s = tab.sets[0];
+    std::printf("%s: %u samples (tabulated) on %s in %.3f s; tables: %u x %u (1 theta row built, %.3f s), grid %u x %u, "
+                "%.1f KiB per table\n",
+                m.name.c_str(), a.n, where.c_str(), b.seconds, s.info.y, s.info.z, tab.seconds, s.grid.x, s.grid.y,
+                (sizeof(TabTable) + 4.0 * (s.grid.x + double(s.grid.x) * s.grid.y)) / 1024.0);
+  } else {
+    std::printf("%s: %u samples (%s%s) on %s in %.3f s\n", m.name.c_str(), a.n, a.sampler.c_str(),
+                strategy == SAMPLER_ANALYTIC && !analyticHasSampler(m.id) ? ": no own sampler, cosine" : "", where.c_str(),
+                b.seconds);
+  }
   std::printf("bound violations %llu, trial failures %llu, failed samples %llu\n",
               static_cast<unsigned long long>(b.boundViolations), static_cast<unsigned long long>(b.trialFailures),
               static_cast<unsigned long long>(failed));
@@ -210,7 +253,7 @@ int benchPrecompute(const BenchArgs& a) {
 
 void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run) {
   auto sa = std::make_shared<SampleArgs>();
-  CLI::App* sample = app.add_subcommand("sample", "Draw directions with the generic quadtree sampler (CSV: x,y,z,pdf,f)");
+  CLI::App* sample = app.add_subcommand("sample", "Draw directions with a BSDF sampling strategy (default: the generic quadtree sampler; CSV: x,y,z,pdf,f)");
   sample->add_option("--model", sa->model, "Reflectance model")->required();
   sample->add_option("--param", sa->params, "name=value (repeatable); overrides the preset");
   sample->add_option("--preset", sa->preset, "Parameter set: typical (default) or hard")->check(CLI::IsMember({"typical", "hard"}));
@@ -222,8 +265,11 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
   sample->add_flag("--cpu", sa->cpu, "Sample on the CPU (the same shared code) instead of the GPU");
   sample->add_option("--seed", sa->seed, "Seed")->capture_default_str();
   sample->add_option("--device", sa->device, "Vulkan device index");
-  sample->add_option("--theta-tables", sa->thetaTables, "Tables along theta")->capture_default_str()->check(CLI::Range(1u, 4096u));
-  sample->add_option("--phi-tables", sa->phiTables, "Tables along phi (anisotropic models)")->capture_default_str()->check(CLI::Range(2u, 1024u));
+X, sa->sampler, "Strategy: quadtree, cosine, uniform, analytic (the model's own importance "
+                                               "sampling), tabulated (CPU only for now)")
+      ->capture_default_str()->check(CLI::IsMember({"quadtree", "cosine", "uniform", "analytic", "tabulated"}));
+  sample->add_option("--tab-bytes", sa->tabBytes, "tabulated: memory budget of one table in bytes (sets the grid)")
+      ->capture_default_str()->check(CLI::Range(std::uint64_t(1024), std::uint64_t(1) << 30));
   sample->callback([sa, &run]() { run = [sa]() { return sampleCommand(*sa); }; });
 
   auto ba = std::make_shared<BenchArgs>();

@@ -5,6 +5,8 @@
 #include <atomic>
 #include <chrono>
 #include <cstring>
+#include <memory>
+#include <stdexcept>
 #include <thread>
 
 #include "../../shaders/shared/layout.h"
@@ -58,8 +60,54 @@ SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint3
   return out;
 }
 
+SampleBatch sampleCpuStrategy(std::uint32_t strategy, const sampling::TabulatedTables* tab, std::uint32_t set,
+                              std::uint32_t model, const BrdfParams& params, vec3 v, std::uint32_t n, std::uint32_t seed,
+                              unsigned threads) {
+  if (strategy == SAMPLER_TABULATED && !tab) throw std::invalid_argument("sampleCpuStrategy: tabulated needs its tables");
+  auto t0 = std::chrono::steady_clock::now();
+  SampleBatch out;
+  out.wPdf.assign(n, vec4(0.0f));
+  out.fOk.assign(n, vec4(0.0f));
+  unsigned nt = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
+  auto work = [&](unsigned t) {
+    std::unique_ptr<sampling::TabHostScope> scope;
+    if (tab) scope = std::make_unique<sampling::TabHostScope>(*tab);
+    for (std::uint32_t i = t; i < n; i += nt) {
+      vec2 u = rng2(i, 0u, RNG_DIM_BSDF, seed);
+      vec3 w(0.0f);
+      float pdf = 0.0f;
+      bool ok = false;
+      if (strategy == SAMPLER_ANALYTIC) {
+        ok = analyticSample(model, params, v, u, w, pdf);
+      } else if (strategy == SAMPLER_TABULATED) {
+        ok = tabSample(set, v, u, w, pdf);
+      } else if (strategy == SAMPLER_UNIFORM) {
+        float r = cosFromSin(u.x), phi = NUSSELT_TWO_PI * u.y;
+        w = vec3(r * std::cos(phi), r * std::sin(phi), u.x);
+        pdf = 0.5f * NUSSELT_INV_PI;
+        ok = w.z > 0.0f;
+      } else {
+        w = squareToCosineHemisphere(u);
+        pdf = cosineHemispherePdf(w);
+        ok = w.z > 0.0f && pdf > 0.0f;
+      }
+      vec3 f = ok ? brdfEval(model, params, w, v) : vec3(0.0f);
+      out.wPdf[i] = vec4(w, ok ? pdf : 0.0f);
+      out.fOk[i] = vec4(f, ok ? 1.0f : 0.0f);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < nt; ++t) pool.emplace_back(work, t);
+  work(0);
+  for (auto& th : pool) th.join();
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
 SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32_t set, std::uint32_t model,
-                      const BrdfParams& params, vec3 v, std::uint32_t n, std::uint32_t seed) {
+                      const BrdfParams& params, vec3 v, std::uint32_t n, std::uint32_t seed, std::uint32_t strategy) {
+  if (strategy == SAMPLER_TABULATED)
+    throw std::invalid_argument("sampleGpu: the tabulated strategy has no GPU buffers yet (use the CPU)");
   SampleBatch out;
   auto upload = [&](const void* data, std::size_t bytes, const char* what) {
     vk::Buffer b = vk::createBuffer(ctx, std::max<std::size_t>(bytes, 16), 0, false, what);
@@ -95,7 +143,7 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
   vk::GlobalsBinding binding = vk::createGlobalsBinding(ctx, globals.buffer, sizeof(StageConstants));
   VkPipelineLayout layout = binding.layout;
   VkDescriptorSet dset = binding.set;
-  vk::ComputePipeline pipe = vk::createComputePipeline(ctx, layout, "sample_tool", {model});
+  vk::ComputePipeline pipe = vk::createComputePipeline(ctx, layout, "sample_tool", {model, strategy});
 
   auto t0 = std::chrono::steady_clock::now();
   // Chunks of at most 65535 workgroups (maxComputeWorkGroupCount on lavapipe).

@@ -5,7 +5,9 @@
 #include <cstdint>
 #include <vector>
 
+#include "../../shaders/shared/bsdf_sampling.h"
 #include "quadtree/sampler_tables.h"
+#include "sampling/tabulated.h"
 #include "vk/vk.h"
 
 namespace nusselt::quadtree {
@@ -23,7 +25,17 @@ struct SampleBatch {
 SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint32_t model, const shared::BrdfParams& params,
                       shared::vec3 v, std::uint32_t n, std::uint32_t seed, unsigned threads = 0);
 
+// The other strategies (SAMPLER_COSINE, SAMPLER_UNIFORM, SAMPLER_ANALYTIC, SAMPLER_TABULATED of
+// shaders/shared/bsdf_sampling.h) on the CPU, with the same random numbers. tabulated needs `tab`
+// and its TabSet index in `set`; the others ignore both.
+SampleBatch sampleCpuStrategy(std::uint32_t strategy, const sampling::TabulatedTables* tab, std::uint32_t set,
+                              std::uint32_t model, const shared::BrdfParams& params, shared::vec3 v, std::uint32_t n,
+                              std::uint32_t seed, unsigned threads = 0);
+
+// strategy: SAMPLER_QUADTREE (default), SAMPLER_COSINE, SAMPLER_UNIFORM or SAMPLER_ANALYTIC (the
+// tabulated strategy has no GPU buffers yet).
 SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32_t set, std::uint32_t model,
-                      const shared::BrdfParams& params, shared::vec3 v, std::uint32_t n, std::uint32_t seed);
+                      const shared::BrdfParams& params, shared::vec3 v, std::uint32_t n, std::uint32_t seed,
+                      std::uint32_t strategy = SAMPLER_QUADTREE);
 
 }  // namespace nusselt::quadtree

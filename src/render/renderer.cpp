@@ -4,10 +4,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <thread>
 
+#include "brdf/albedo.h"
 #include "quadtree/sampler_tables.h"
 #include "scene/bvh.h"
 #include "util/error.h"
@@ -18,6 +20,7 @@ using shared::BvhNode;
 using shared::DispatchArgs;
 using shared::Globals;
 using shared::GpuLight;
+using shared::GpuComponent;
 using shared::GpuMaterial;
 using shared::GpuTriangle;
 using shared::GpuTriShading;
@@ -37,12 +40,28 @@ const char* samplerName(SamplerKind kind) {
     case SamplerKind::Quadtree: return "quadtree";
     case SamplerKind::Cosine: return "cosine";
     case SamplerKind::Uniform: return "uniform";
+    case SamplerKind::Analytic: return "analytic";
+    case SamplerKind::Tabulated: return "tabulated";
   }
   return "?";
 }
 
+const char* componentSelectionName(ComponentSelection mode) {
+  return mode == ComponentSelection::Uniform ? "uniform" : "albedo";
+}
+
+bool parseComponentSelection(const std::string& name, ComponentSelection& mode) {
+  for (ComponentSelection m : {ComponentSelection::Albedo, ComponentSelection::Uniform})
+    if (name == componentSelectionName(m)) {
+      mode = m;
+      return true;
+    }
+  return false;
+}
+
 bool parseSampler(const std::string& name, SamplerKind& kind) {
-  for (SamplerKind k : {SamplerKind::Quadtree, SamplerKind::Cosine, SamplerKind::Uniform})
+  for (SamplerKind k : {SamplerKind::Quadtree, SamplerKind::Cosine, SamplerKind::Uniform, SamplerKind::Analytic,
+                        SamplerKind::Tabulated})
     if (name == samplerName(k)) {
       kind = k;
       return true;
@@ -69,6 +88,13 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   if (settings.width == 0 || settings.height == 0) throw Error("image size must be at least 1x1");
   std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;
   if (pixels > (1ull << 28)) throw Error("image too large: at most 2^28 pixels");
+  // TODO(issue 5): the tabulated strategy's tables have no GPU buffers yet (the wiring steps are in
+  // shaders/shared/bsdf_sampling.h); until then a render that asks for it samples with cosine.
+  if (m_settings.sampler == SamplerKind::Tabulated) {
+    std::fprintf(stderr, "error: sampler tabulated is not wired into the renderer yet (its tables have no GPU "
+                         "buffers): rendering with cosine sampling instead\n");
+    m_settings.sampler = SamplerKind::Cosine;
+  }
   // One indirect dispatch covers a whole queue: its group count must stay <= 65535.
   std::uint32_t maxChunk = std::min<std::uint32_t>(settings.maxPathsPerChunk, 65535u * WORKGROUP_SIZE);
   m_capacity = static_cast<std::uint32_t>(std::min<std::uint64_t>(pixels, maxChunk));
@@ -125,31 +151,70 @@ void Renderer::uploadScene(const Scene& scene) {
   m_summary.bvhSeconds = seconds(t0);
   m_summary.bvhNodes = static_cast<std::uint32_t>(bvh.nodes.size());
 
-  // ---- Materials and the model slots this render needs ----
+  // ---- Materials and the shade slots this render needs ----
+  // A slot is a shade pipeline and its queue. Key: {0, model} for a single-model material,
+  // {n, model_0, ..., model_{n-1}} for a combined one (one pipeline per tuple of component models,
+  // in the material's order). Sorted, so single-model slots keep the order of their model ids.
   std::vector<GpuMaterial> materials(std::max<std::size_t>(scene.materials.size(), 1));
-  std::vector<std::uint32_t> usedModels;
+  std::vector<GpuComponent> components;
   std::vector<bool> materialUsed(materials.size(), false);
   for (std::uint32_t m : scene.triangleMaterial) materialUsed.at(m) = true;
-  for (std::size_t i = 0; i < scene.materials.size(); ++i)
-    if (materialUsed[i] && std::find(usedModels.begin(), usedModels.end(), scene.materials[i].model) == usedModels.end())
-      usedModels.push_back(scene.materials[i].model);
-  std::sort(usedModels.begin(), usedModels.end());
-  if (usedModels.size() > MAX_MODEL_SLOTS) throw Error("internal: too many models in one scene");
-  m_slotModels = usedModels;
-  for (std::uint32_t id : usedModels) m_summary.models.push_back(modelById(id).name);
+  auto slotKey = [](const Material& m) {
+    std::vector<std::uint32_t> key;
+    if (!m.combined()) return std::vector<std::uint32_t>{0u, m.model};
+    key.push_back(static_cast<std::uint32_t>(m.components.size()));
+    for (const MaterialComponent& c : m.components) key.push_back(c.model);
+    return key;
+  };
+  std::vector<std::vector<std::uint32_t>> slots;
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    if (!materialUsed[i]) continue;
+    const Material& m = scene.materials[i];
+    if (m.components.size() > MAX_COMPONENTS)
+      throw Error("material " + m.name + ": " + std::to_string(m.components.size()) + " components, at most " +
+                  std::to_string(MAX_COMPONENTS));
+    std::vector<std::uint32_t> key = slotKey(m);
+    if (std::find(slots.begin(), slots.end(), key) == slots.end()) slots.push_back(key);
+  }
+  std::sort(slots.begin(), slots.end());
+  if (slots.size() > MAX_MODEL_SLOTS)
+    throw Error("the scene uses " + std::to_string(slots.size()) + " distinct models and combinations of models, at most " +
+                std::to_string(MAX_MODEL_SLOTS));
+  m_slotKeys = slots;
+  for (const auto& key : slots) {
+    std::string name;
+    for (std::size_t k = 1; k < key.size(); ++k) name += (k > 1 ? "+" : "") + modelById(key[k]).name;
+    m_summary.models.push_back(name);
+  }
   for (std::size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& src = scene.materials[i];
     GpuMaterial& dst = materials[i];
     std::uint32_t slot = 0;
-    for (std::uint32_t s = 0; s < usedModels.size(); ++s)
-      if (usedModels[s] == src.model) slot = s;
+    std::vector<std::uint32_t> key = slotKey(src);
+    for (std::uint32_t s = 0; s < slots.size(); ++s)
+      if (slots[s] == key) slot = s;
     std::uint32_t flags = 0;
     if (luminance(src.emission) > 0.0f || src.emission.x > 0 || src.emission.y > 0 || src.emission.z > 0)
       flags |= MATERIAL_EMISSIVE;
-    if (modelById(src.model).delta) flags |= MATERIAL_DELTA;
-    dst.info = glm::uvec4(src.model, flags, INVALID_INDEX, slot);
+    bool allDelta = true;
+    for (const MaterialComponent& c : src.components) allDelta = allDelta && modelById(c.model).delta;
+    if (src.combined() ? allDelta : modelById(src.model).delta) flags |= MATERIAL_DELTA;
+    if (src.combined()) flags |= MATERIAL_COMBINED;
+    dst.info = glm::uvec4(src.combined() ? src.components[0].model : src.model, flags, INVALID_INDEX, slot);
     dst.emission = v4(src.emission);
     dst.params = src.params;
+    dst.components = glm::uvec4(0u);
+    if (src.combined() && materialUsed[i]) {
+      dst.components = glm::uvec4(static_cast<std::uint32_t>(components.size()),
+                                  static_cast<std::uint32_t>(src.components.size()), 0u, 0u);
+      for (const MaterialComponent& c : src.components) {
+        GpuComponent g{};
+        g.info = glm::uvec4(c.model, INVALID_INDEX, 0u, 0u);
+        g.data = glm::vec4(c.weight, 0.0f, 0.0f, 0.0f);
+        g.params = c.params;
+        components.push_back(g);
+      }
+    }
   }
 
   // ---- Triangles, shading data and lights ----
@@ -236,7 +301,8 @@ void Renderer::uploadScene(const Scene& scene) {
     std::uint64_t need = std::max<std::size_t>(bvh.nodes.size(), 1) * sizeof(BvhNode) + tris.size() * sizeof(GpuTriangle) +
                          shading.size() * sizeof(GpuTriShading) + materials.size() * sizeof(GpuMaterial) +
                          lights.size() * sizeof(GpuLight) + cdf.size() * 4 + pixels * 32 + cap * 9 * 16 +
-                         (QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + usedModels.size()) * cap) * 4;
+                         components.size() * sizeof(GpuComponent) +
+                         (QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + slots.size()) * cap) * 4;
     std::uint64_t have = vk::deviceLocalHeapSize(m_ctx);
     auto mib = [](std::uint64_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
     if (have && need > have)
@@ -283,7 +349,7 @@ void Renderer::uploadScene(const Scene& scene) {
   g.shadowOrigin = make(cap * 16, "shadow ray origin")->address;
   g.shadowDirection = make(cap * 16, "shadow ray direction")->address;
   g.shadowRadiance = make(cap * 16, "shadow ray radiance")->address;
-  std::uint64_t queueUints = QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + usedModels.size()) * cap;
+  std::uint64_t queueUints = QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + slots.size()) * cap;
   m_queues = make(queueUints * 4, "queue");
   g.queues = m_queues->address;
   m_args = make(QUEUE_COUNT * sizeof(DispatchArgs), "dispatch arguments", nullptr, VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
@@ -291,20 +357,29 @@ void Renderer::uploadScene(const Scene& scene) {
   m_stats = make(STAT_COUNT * 4, "statistics", nullptr, 0, true);
   std::memset(m_stats->mapped, 0, STAT_COUNT * 4);
   g.stats = m_stats->address;
-  // ---- The generic sampler's quadtrees: only for the non-delta materials the scene uses ----
+  // ---- The generic sampler's quadtrees: only for the non-delta materials (and non-delta
+  // components of combined materials) the scene uses; identical (model, params) share a set ----
   std::vector<std::pair<std::uint32_t, shared::BrdfParams>> toBuild;
-  std::vector<std::size_t> builtMaterial;
+  std::vector<std::uint32_t*> builtSet;  // where each built set's index goes
   if (m_settings.sampler == SamplerKind::Quadtree)
-    for (std::size_t i = 0; i < scene.materials.size(); ++i)
-      if (materialUsed[i] && !modelById(scene.materials[i].model).delta) {
-        toBuild.push_back({scene.materials[i].model, scene.materials[i].params});
-        builtMaterial.push_back(i);
+    for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+      if (!materialUsed[i]) continue;
+      const Material& m = scene.materials[i];
+      if (!m.combined() && !modelById(m.model).delta) {
+        toBuild.push_back({m.model, m.params});
+        builtSet.push_back(&materials[i].info.z);
       }
+      for (std::size_t k = 0; k < m.components.size(); ++k)
+        if (!modelById(m.components[k].model).delta) {
+          toBuild.push_back({m.components[k].model, m.components[k].params});
+          builtSet.push_back(&components[materials[i].components.x + k].info.y);
+        }
+    }
   quadtree::SamplerTables qt;
   if (!toBuild.empty()) {
     std::vector<std::uint32_t> setOf;
     qt = quadtree::buildSamplerTables(toBuild, quadtree::QuadtreeSettings{}, setOf);
-    for (std::size_t k = 0; k < builtMaterial.size(); ++k) materials[builtMaterial[k]].info.z = setOf[k];
+    for (std::size_t k = 0; k < builtSet.size(); ++k) *builtSet[k] = setOf[k];
     m_summary.samplerSeconds = qt.seconds;
     m_summary.samplerTrees = static_cast<std::uint32_t>(qt.tables.size());
     m_summary.samplerBytes = qt.bytes();
@@ -313,6 +388,23 @@ void Renderer::uploadScene(const Scene& scene) {
     m_summary.samplerCacheRejected = qt.cacheRejected;
     vk::uploadBuffer(m_ctx, *materialBuffer, materials.data(), materials.size() * sizeof(GpuMaterial));
   }
+  // Components without a QuadSet (other samplers) choose by a CPU-tabulated albedo over
+  // cos theta_o (the choice probability must be known before sampling; any positive function of
+  // wo keeps the estimator unbiased, the albedo keeps the weights near 1). Floored at 1e-4 so
+  // that no component whose BRDF is not zero is ever left unsampled.
+  for (GpuComponent& c : components) {
+    if (modelById(c.info.x).delta || c.info.y != INVALID_INDEX) continue;
+    float table[COMPONENT_ALBEDO_NODES];
+    for (std::uint32_t n = 0; n < COMPONENT_ALBEDO_NODES; ++n) {
+      double cosTheta = std::max(double(n) / (COMPONENT_ALBEDO_NODES - 1), 0.02);
+      double a = directionalAlbedo(c.info.x, c.params, std::acos(cosTheta) * 180.0 / M_PI);
+      table[n] = std::isfinite(a) ? std::max(float(a), 1e-4f) : 1e-4f;
+    }
+    c.albedoLo = glm::vec4(table[0], table[1], table[2], table[3]);
+    c.albedoHi = glm::vec4(table[4], table[5], table[6], table[7]);
+  }
+  g.components = make(std::max<std::size_t>(components.size(), 1) * sizeof(GpuComponent), "material components",
+                      components.empty() ? nullptr : components.data())->address;
   auto orOne = [](auto& v) {
     if (v.empty()) v.resize(1);
     return v.size();
@@ -337,7 +429,8 @@ void Renderer::uploadScene(const Scene& scene) {
   g.frame = glm::uvec4(0u, m_settings.seed, m_settings.maxDepth, m_capacity);
   g.counts = glm::uvec4(static_cast<std::uint32_t>(materials.size()), static_cast<std::uint32_t>(weights.size()),
                         static_cast<std::uint32_t>(triCount), static_cast<std::uint32_t>(m_settings.lighting));
-  g.options = glm::uvec4(static_cast<std::uint32_t>(m_settings.rng), 0u, 0u, 0u);
+  g.options = glm::uvec4(static_cast<std::uint32_t>(m_settings.rng), static_cast<std::uint32_t>(m_settings.components),
+                         0u, 0u);
   m_globals.resize(sizeof(Globals));
   std::memcpy(m_globals.data(), &g, sizeof g);
   writeCamera(m_cameraState);
@@ -390,18 +483,27 @@ void Renderer::createPipelines() {
   m_intersect = vk::createComputePipeline(m_ctx, m_pipelineLayout, "intersect");
   m_shadow = vk::createComputePipeline(m_ctx, m_pipelineLayout, "shadow");
   m_accumulate = vk::createComputePipeline(m_ctx, m_pipelineLayout, "accumulate");
-  // Only the models this scene uses: one specialised shade pipeline each, created on all cores
-  // (drivers compile at creation; lavapipe takes ~0.3 s per shade pipeline, single-threaded).
-  m_shade.resize(m_slotModels.size());
+  // Only the models (and combinations) this scene uses: one specialised shade pipeline each,
+  // created on all cores (drivers compile at creation; lavapipe takes ~0.3 s per shade pipeline,
+  // single-threaded). Single-model pipelines get exactly (MODEL_ID, SAMPLER) as before;
+  // combined ones (MODEL_ID unused, SAMPLER, COMPONENT_COUNT, MODEL_0..MODEL_3).
+  const std::size_t slotCount = m_slotKeys.size();
+  m_shade.resize(slotCount);
   std::vector<std::thread> workers;
-  std::vector<std::string> errors(m_slotModels.size());
-  const unsigned threads = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), unsigned(m_slotModels.size())));
+  std::vector<std::string> errors(slotCount);
+  const unsigned threads = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), unsigned(slotCount)));
   for (unsigned t = 0; t < threads; ++t)
     workers.emplace_back([&, t] {
-      for (std::size_t s = t; s < m_slotModels.size(); s += threads) {
+      for (std::size_t s = t; s < slotCount; s += threads) {
         try {
-          m_shade[s] = vk::createComputePipeline(m_ctx, m_pipelineLayout, "shade",
-                                                 {m_slotModels[s], static_cast<std::uint32_t>(m_settings.sampler)});
+          const std::vector<std::uint32_t>& key = m_slotKeys[s];
+          const std::uint32_t sampler = static_cast<std::uint32_t>(m_settings.sampler);
+          std::vector<std::uint32_t> spec{key[1], sampler};
+          if (key[0] > 0) {
+            spec.push_back(key[0]);
+            for (std::uint32_t k = 0; k < MAX_COMPONENTS; ++k) spec.push_back(k < key[0] ? key[1 + k] : key[1]);
+          }
+          m_shade[s] = vk::createComputePipeline(m_ctx, m_pipelineLayout, "shade", spec);
         } catch (const std::exception& e) {
           errors[s] = e.what();
         }
@@ -428,7 +530,7 @@ void Renderer::dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::ui
 
 void Renderer::recordPass(VkCommandBuffer cmd, std::uint32_t chunkStart, std::uint32_t chunkCount) {
   (void)chunkStart;
-  const std::uint32_t slots = static_cast<std::uint32_t>(m_slotModels.size());
+  const std::uint32_t slots = static_cast<std::uint32_t>(m_slotKeys.size());
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_pipelineLayout, 0, 1, &m_set, 0, nullptr);
   m_marks.clear();
   if (m_queryPool) vkCmdResetQueryPool(cmd, m_queryPool, 0, m_queryCapacity);

@@ -16,7 +16,7 @@ namespace nusselt {
 enum class LightingMode : std::uint32_t { Mis = 0, NeeOnly = 1, BsdfOnly = 2 };
 const char* lightingModeName(LightingMode mode);
 // BSDF sampling strategy for non-delta models (SAMPLER_* in shaders/shared/bsdf_sampling.h).
-enum class SamplerKind : std::uint32_t { Quadtree = 0, Cosine = 1, Uniform = 2 };
+enum class SamplerKind : std::uint32_t { Quadtree = 0, Cosine = 1, Uniform = 2, Analytic = 3, Tabulated = 4 };
 const char* samplerName(SamplerKind kind);
 // nullptr-safe parse: returns false for an unknown name.
 bool parseSampler(const std::string& name, SamplerKind& kind);
@@ -24,6 +24,13 @@ bool parseSampler(const std::string& name, SamplerKind& kind);
 // Random numbers: independent PCG hashes, or padded Owen-scrambled Sobol (quasi-Monte Carlo).
 enum class RngMode : std::uint32_t { Pcg = 0, Qmc = 1 };
 const char* rngModeName(RngMode mode);
+
+// How a combined material chooses its component at a bounce (COMPONENTS_* in layout.h): albedo =
+// the random-walk source's estimator (probability = the component's albedo for wo, the rest ends
+// the walk); uniform = probability 1/n and a separate albedo roulette (for comparison).
+enum class ComponentSelection : std::uint32_t { Albedo = 0, Uniform = 1 };
+const char* componentSelectionName(ComponentSelection mode);
+bool parseComponentSelection(const std::string& name, ComponentSelection& mode);
 
 struct RenderSettings {
   std::uint32_t width = 512;
@@ -34,6 +41,7 @@ struct RenderSettings {
   LightingMode lighting = LightingMode::Mis;
   RngMode rng = RngMode::Pcg;
   SamplerKind sampler = SamplerKind::Quadtree;  // the generic sampler of Montes et al.
+  ComponentSelection components = ComponentSelection::Albedo;  // combined materials only
   // Sample indices of this render start here (`--spp-offset`): a frame can be split across
   // machines into disjoint sample ranges and merged (`nusselt merge`).
   std::uint32_t sampleOffset = 0;
@@ -56,7 +64,7 @@ struct SceneSummary {
   std::size_t triangles = 0;
   std::size_t materials = 0;
   std::size_t lights = 0;
-  std::vector<std::string> models;  // models the render's shade stages contain
+  std::vector<std::string> models;  // models the render's shade stages contain ("a+b": combined)
   double bvhSeconds = 0;
   std::uint32_t bvhNodes = 0;
   double pipelineSeconds = 0;       // creating the pipelines (lavapipe compiles at first dispatch)
@@ -121,7 +129,8 @@ class Renderer {
   std::uint32_t m_capacity = 0;
   RenderStats m_totals;
   Camera m_cameraState;
-  std::vector<std::uint32_t> m_slotModels;  // model id of each shade slot
+  // Key of each shade slot: {0, model} (single model) or {n, model_0, ..., model_{n-1}} (combined).
+  std::vector<std::vector<std::uint32_t>> m_slotKeys;
 
   // Host copy of the globals, rewritten before each chunk.
   std::vector<unsigned char> m_globals;

@@ -558,21 +558,69 @@ class Converter {
       const tinygltf::Value& v = brdf->second;
       std::string known;
       for (const ModelSpec& s : allModels()) known += (known.empty() ? "" : ", ") + s.name;
-      if (!v.IsObject()) throw Error(context + ": must be an object {\"model\": ..., \"params\": {...}}");
-      if (!v.Has("model") || !v.Get("model").IsString())
-        throw Error(context + ": \"model\" must be a string (known models: " + known + ")");
-      const std::string modelName = v.Get("model").Get<std::string>();
-      const ModelSpec* spec = findModel(modelName);
-      if (!spec) throw Error(context + ": unknown model " + quoted(modelName) + " (known models: " + known + ")");
-      NamedParams params;
-      if (v.Has("params")) {
-        const tinygltf::Value& p = v.Get("params");
-        if (!p.IsObject()) throw Error(context + ": \"params\" must be an object");
-        for (const std::string& key : p.Keys())
-          params.emplace_back(key, toParamValue(p.Get(key), context + ": parameter " + quoted(key)));
+      if (!v.IsObject())
+        throw Error(context + ": must be an object {\"model\": ..., \"params\": {...}} or {\"components\": [...]}");
+      // One model and its parameters: {"model": name, "params": {...}} (the object `where` names).
+      auto parseModel = [&](const tinygltf::Value& o, const std::string& where) -> std::pair<const ModelSpec*, BrdfParams> {
+        if (!o.Has("model") || !o.Get("model").IsString())
+          throw Error(where + ": \"model\" must be a string (known models: " + known + ")");
+        const std::string modelName = o.Get("model").Get<std::string>();
+        const ModelSpec* spec = findModel(modelName);
+        if (!spec) throw Error(where + ": unknown model " + quoted(modelName) + " (known models: " + known + ")");
+        NamedParams params;
+        if (o.Has("params")) {
+          const tinygltf::Value& p = o.Get("params");
+          if (!p.IsObject()) throw Error(where + ": \"params\" must be an object");
+          for (const std::string& key : p.Keys())
+            params.emplace_back(key, toParamValue(p.Get(key), where + ": parameter " + quoted(key)));
+        }
+        return {spec, packParams(*spec, params, where)};
+      };
+      if (v.Has("components")) {
+        // A combined material: f = sum_k weight_k f_k (docs/scenes.md).
+        if (v.Has("model") || v.Has("params"))
+          throw Error(context + ": give either \"model\" (and \"params\") or \"components\", not both");
+        const tinygltf::Value& list = v.Get("components");
+        if (!list.IsArray() || list.ArrayLen() == 0)
+          throw Error(context + ".components: must be a non-empty array of {\"model\": ..., \"weight\": ..., "
+                                "\"params\": {...}}");
+        if (list.ArrayLen() > MAX_COMPONENTS)
+          throw Error(context + ".components: " + str(std::uint64_t(list.ArrayLen())) + " components, at most " +
+                      str(std::uint64_t(MAX_COMPONENTS)));
+        for (std::size_t k = 0; k < list.ArrayLen(); ++k) {
+          const std::string where = context + ".components[" + str(std::uint64_t(k)) + "]";
+          const tinygltf::Value& c = list.Get(int(k));
+          if (!c.IsObject()) throw Error(where + ": must be an object {\"model\": ..., \"weight\": ..., \"params\": {...}}");
+          for (const std::string& key : c.Keys())
+            if (key != "model" && key != "weight" && key != "params")
+              throw Error(where + ": unknown field " + quoted(key) + " (expected model, weight, params)");
+          MaterialComponent mc;
+          if (c.Has("weight")) {
+            const tinygltf::Value& w = c.Get("weight");
+            if (!w.IsNumber()) throw Error(where + ".weight: must be a number");
+            double weight = w.GetNumberAsDouble();
+            if (!std::isfinite(weight) || weight < 0 || weight > 1e6)
+              throw Error(where + ".weight: " + fmt(weight) + " is not a finite number in [0, 1e6]");
+            mc.weight = static_cast<float>(weight);
+          }
+          auto [spec, params] = parseModel(c, where);
+          mc.model = spec->id;
+          mc.params = params;
+          m.components.push_back(mc);
+        }
+        m.model = m.components[0].model;
+        m.params = m.components[0].params;
+        // One component of weight 1 is the single-model form (same shading code and performance).
+        if (m.components.size() == 1 && m.components[0].weight == 1.0f) m.components.clear();
+      } else {
+        // (tinygltf drops an empty array, so "components": [] arrives here.)
+        if (!v.Has("model"))
+          throw Error(context + ": needs \"model\" (a string; known models: " + known +
+                      ") or \"components\" (a non-empty array of {\"model\": ..., \"weight\": ..., \"params\": {...}})");
+        auto [spec, params] = parseModel(v, context);
+        m.model = spec->id;
+        m.params = params;
       }
-      m.model = spec->id;
-      m.params = packParams(*spec, params, context);
     } else {
       // Without NUSSELT_brdf a material uses the glTF 2.0 metallic-roughness BRDF itself
       // (gltf_pbr): baseColor = baseColorFactor.rgb clamped to [0, 1] (alpha is ignored),

@@ -12,11 +12,24 @@
 
 namespace nusselt {
 
+// One term w * f_k of a combined material.
+struct MaterialComponent {
+  std::uint32_t model = MODEL_LAMBERT;  // MODEL_* id (any catalogue model, delta ones included)
+  float weight = 1.0f;                  // finite, >= 0
+  BrdfParams params{};                  // packed by packParams()
+};
+
 struct Material {
   std::string name;
   std::uint32_t model = MODEL_LAMBERT;  // MODEL_* id
   BrdfParams params{};                  // packed by packParams()
   glm::vec3 emission{0.0f};             // emitted radiance [W/(m^2 sr)], front faces only
+  // Not empty: a combined material f = sum_k weight_k f_k (at most MAX_COMPONENTS terms; the
+  // random-walk source's estimator picks one per bounce, shaders/shared/combined.h). model and
+  // params then repeat the first component and are not used for shading.
+  std::vector<MaterialComponent> components;
+
+  bool combined() const { return !components.empty(); }
 };
 
 enum class LightType { Point, Spot, Directional };

@@ -2,7 +2,7 @@
 """Writes the generated glTF/GLB seeds of tests/fuzz/corpus/gltf (the others are copies of
 tests/data/gltf, scenes/tests and scenes/cornell-box.glb). Small files that between them reach
 every branch of the loader: embedded and GLB buffers, strips and fans, index types, normals,
-NUSSELT_brdf, lights, cameras, emissive strength, hierarchies."""
+NUSSELT_brdf (single model and components), lights, cameras, emissive strength, hierarchies."""
 import base64, json, os, struct
 
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus", "gltf")
@@ -95,6 +95,13 @@ seeds["hierarchy_lights_camera.glb"] = scene(quad + normals, [pos, nrm], views,
 nan = floats(0, 0, 0, float("nan"), 0, 0, 1, 1, 0, 0, 1, float("inf"))
 seeds["nonfinite_vertices.gltf"] = scene(nan + normals, [pos, nrm], views,
                                          [{"attributes": {"POSITION": 0, "NORMAL": 1}, "mode": 6}])
+
+combined = {"materials": [{"name": "glaze", "extensions": {"NUSSELT_brdf": {"components": [
+    {"model": "lambert", "weight": 0.6, "params": {"rho": [0.5, 0.4, 0.3]}},
+    {"model": "phong", "weight": 1.0, "params": {"kd": 0, "ks": 0.3, "n": 50}},
+    {"model": "mirror", "weight": 0.2, "params": {"eta": 0.96, "k": 6.69}}]}}}],
+            "extensionsUsed": ["NUSSELT_brdf"]}
+seeds["quad_combined_brdf.gltf"] = scene(quad + normals + idx16, a, v, prim, combined)
 
 for name, data in seeds.items():
     with open(os.path.join(OUT, name), "wb") as f:

@@ -346,6 +346,74 @@ TEST(GltfLoader, MaterialsBrdfAndEmission) {
   EXPECT_HAS(e, "emissiveStrength");
 }
 
+TEST(GltfLoader, CombinedMaterialComponents) {
+  Json j = triangleModel();
+  j["extensionsUsed"] = {"NUSSELT_brdf"};
+  j["materials"] = Json::parse(R"([{"name": "Glaze", "extensions": {"NUSSELT_brdf": {"components": [
+      {"model": "lambert", "weight": 0.6, "params": {"rho": [0.5, 0.4, 0.3]}},
+      {"model": "phong", "params": {"ks": 0.3, "n": 50}},
+      {"model": "mirror", "weight": 0.2}]}}},
+    {"name": "One", "extensions": {"NUSSELT_brdf": {"components": [{"model": "phong"}]}}}])");
+  j["meshes"][0]["primitives"][0]["material"] = 0;
+  Scene s = loadJson(j);
+  ASSERT_EQ(s.materials.size(), 2u);
+  const Material& m = s.materials[0];
+  ASSERT_EQ(m.components.size(), 3u);
+  EXPECT_TRUE(m.combined());
+  EXPECT_EQ(m.components[0].model, MODEL_LAMBERT);
+  EXPECT_FLOAT_EQ(m.components[0].weight, 0.6f);
+  EXPECT_FLOAT_EQ(m.components[0].params.v[0][1], 0.4f);
+  EXPECT_EQ(m.components[1].model, MODEL_PHONG);
+  EXPECT_FLOAT_EQ(m.components[1].weight, 1.0f);  // default weight
+  EXPECT_FLOAT_EQ(shared::brdfParam(m.components[1].params, PHONG_N), 50.0f);
+  EXPECT_EQ(m.components[2].model, MODEL_MIRROR);
+  EXPECT_FLOAT_EQ(m.components[2].weight, 0.2f);
+  EXPECT_EQ(m.model, MODEL_LAMBERT);  // repeats the first component
+  // One component of weight 1 is the single-model form.
+  EXPECT_FALSE(s.materials[1].combined());
+  EXPECT_EQ(s.materials[1].model, MODEL_PHONG);
+  EXPECT_TRUE(s.warnings.empty());
+}
+
+TEST(GltfLoaderErrors, CombinedMaterialComponents) {
+  auto errorWith = [](const char* brdf) {
+    Json j = triangleModel();
+    j["extensionsUsed"] = {"NUSSELT_brdf"};
+    j["materials"] = Json::array({Json::object()});
+    j["materials"][0]["name"] = "Glaze";
+    j["materials"][0]["extensions"]["NUSSELT_brdf"] = Json::parse(brdf);
+    return jsonError(j);
+  };
+  const std::string where = "mem.gltf: materials[0] \"Glaze\" NUSSELT_brdf";
+  std::string e = errorWith(R"({"components": [{"model": "lambert"}, {"model": "no_such_model"}]})");
+  EXPECT_HAS(e, where + ".components[1]");
+  EXPECT_HAS(e, "unknown model \"no_such_model\"");
+  e = errorWith(R"({"components": [{"model": "lambert", "weight": -0.5}]})");
+  EXPECT_HAS(e, where + ".components[0].weight");
+  EXPECT_HAS(e, "-0.5");
+  e = errorWith(R"({"components": [{"model": "lambert", "weight": "heavy"}]})");
+  EXPECT_HAS(e, where + ".components[0].weight: must be a number");
+  e = errorWith(R"({"components": [{"model": "lambert", "weight": 1e300}, {"model": "phong"}]})");
+  EXPECT_HAS(e, where + ".components[0].weight");
+  e = errorWith(R"({"components": [{"model": "lambert"}, {"model": "phong"}, {"model": "mirror"},
+                                   {"model": "ward"}, {"model": "lambert"}]})");
+  EXPECT_HAS(e, where + ".components: 5 components, at most 4");
+  e = errorWith(R"({"components": []})");
+  EXPECT_HAS(e, where + ": needs \"model\"");
+  EXPECT_HAS(e, "\"components\" (a non-empty array");
+  e = errorWith(R"({"components": {"model": "lambert"}})");
+  EXPECT_HAS(e, where + ".components: must be a non-empty array");
+  e = errorWith(R"({"model": "lambert", "components": [{"model": "phong"}]})");
+  EXPECT_HAS(e, "not both");
+  e = errorWith(R"({"components": [{"model": "lambert", "params": {"rho": 1.5}}]})");
+  EXPECT_HAS(e, where + ".components[0]");
+  EXPECT_HAS(e, "\"rho\" = 1.5");
+  e = errorWith(R"({"components": [{"model": "lambert", "colour": 1}]})");
+  EXPECT_HAS(e, where + ".components[0]: unknown field \"colour\"");
+  e = errorWith(R"({"components": [7]})");
+  EXPECT_HAS(e, where + ".components[0]: must be an object");
+}
+
 TEST(GltfLoader, UnsupportedFeaturesWarn) {
   Json j = triangleModel();
   j["extensionsUsed"] = {"KHR_texture_transform", "KHR_materials_clearcoat"};
