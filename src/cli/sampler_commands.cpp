@@ -265,7 +265,9 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
   sample->add_flag("--cpu", sa->cpu, "Sample on the CPU (the same shared code) instead of the GPU");
   sample->add_option("--seed", sa->seed, "Seed")->capture_default_str();
   sample->add_option("--device", sa->device, "Vulkan device index");
-X, sa->sampler, "Strategy: quadtree, cosine, uniform, analytic (the model's own importance "
+  sample->add_option("--theta-tables", sa->thetaTables, "Tables along theta")->capture_default_str()->check(CLI::Range(1u, 4096u));
+  sample->add_option("--phi-tables", sa->phiTables, "Quadtree tables along phi (anisotropic models)")->capture_default_str()->check(CLI::Range(2u, 1024u));
+  sample->add_option("--sampler", sa->sampler, "Strategy: quadtree, cosine, uniform, analytic (the model's own importance "
                                                "sampling), tabulated (CPU only for now)")
       ->capture_default_str()->check(CLI::IsMember({"quadtree", "cosine", "uniform", "analytic", "tabulated"}));
   sample->add_option("--tab-bytes", sa->tabBytes, "tabulated: memory budget of one table in bytes (sets the grid)")
