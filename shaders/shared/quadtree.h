@@ -29,14 +29,16 @@ struct QuadHost {
   std::uint64_t trials = 0;           // total rejection trials (proposal draws, statistics)
   std::uint64_t evaluations = 0;      // trials that evaluated f (inside leaf & disc)
   std::uint64_t samples = 0;          // calls of quadSample that reached a leaf
+  std::uint64_t nodeReads = 0;        // inner nodes read by the descents
   // Optional, per leaf (global leaf index): evaluations of f and accepted samples; the test of
   // "every leaf accepts at least 1 / n_max of its candidates" reads them.
   std::uint64_t* leafEvaluations = nullptr;
   std::uint64_t* leafAccepted = nullptr;
 };
 inline thread_local QuadHost* g_quadHost = nullptr;
-inline void quadCountTrials(std::uint32_t evals, std::uint32_t trials, std::uint32_t leaf, bool accepted) {
+inline void quadCountTrials(std::uint32_t evals, std::uint32_t trials, std::uint32_t depth, std::uint32_t leaf, bool accepted) {
   QuadHost* h = g_quadHost;
+  h->nodeReads += depth;
   h->trials += trials;
   h->evaluations += evals;
   h->samples++;
@@ -50,7 +52,7 @@ SHARED_END
 #define QT_LEAF(i) (::nusselt::shared::g_quadHost->leaves[i])
 #define QT_COUNT_BOUND_VIOLATION() (::nusselt::shared::g_quadHost->boundViolations++)
 #define QT_COUNT_TRIAL_FAILURE() (::nusselt::shared::g_quadHost->trialFailures++)
-#define QT_COUNT_TRIALS(evals, n, leaf, ok) ::nusselt::shared::quadCountTrials(evals, n, leaf, ok)
+#define QT_COUNT_TRIALS(evals, n, depth, leaf, ok) ::nusselt::shared::quadCountTrials(evals, n, depth, leaf, ok)
 #else
 #define QT_SET(i) (g.quadSets.v[i])
 #define QT_TABLE(i) (g.quadTables.v[i])
@@ -58,7 +60,7 @@ SHARED_END
 #define QT_LEAF(i) (g.quadLeaves.v[i])
 #define QT_COUNT_BOUND_VIOLATION() atomicAdd(g.stats.v[STAT_SAMPLER_BOUND_VIOLATIONS], 1u)
 #define QT_COUNT_TRIAL_FAILURE() atomicAdd(g.stats.v[STAT_SAMPLER_TRIAL_FAILURES], 1u)
-#define QT_COUNT_TRIALS(evals, n, leaf, ok)
+#define QT_COUNT_TRIALS(evals, n, depth, leaf, ok)
 #endif
 
 SHARED_BEGIN
@@ -232,8 +234,10 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, uv
     float x0 = -1.0f, x1 = 1.0f, y0 = -1.0f, y1 = 1.0f;
     float ux = u.x;
     uint link = T.info.x;
+    uint depth = 0u;
     for (uint d = 0u; d < QT_MAX_DESCENT; ++d) {
       if ((link & QT_LEAF_BIT) != 0u) break;
+      ++depth;
       QuadNode N = QT_NODE(link);
       float m0 = N.mass.x, m1 = N.mass.y, m2 = N.mass.z, m3 = N.mass.w;
       float t = ux * (m0 + m1 + m2 + m3);
@@ -315,7 +319,7 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, uv
       if (fl > e) violated = true;
       if (cc * e < fl) { accepted = true; break; }
     }
-    QT_COUNT_TRIALS(evaluations, trial + 1u, link & ~QT_LEAF_BIT, accepted);
+    QT_COUNT_TRIALS(evaluations, trial + 1u, depth, link & ~QT_LEAF_BIT, accepted);
     if (violated) QT_COUNT_BOUND_VIOLATION();
     if (!accepted) {
       QT_COUNT_TRIAL_FAILURE();

@@ -22,17 +22,17 @@ struct QuadNode {
 };
 STATIC_ASSERT_SIZE(QuadNode, 32);
 
-// data = (M: upper bound of f (QT_PROPOSAL_UNIFORM) or of f cos^s (QT_PROPOSAL_RIM) over the
-//         leaf, mass: integral of f over the leaf and the disc, proposal kind (QT_PROPOSAL_*, as a
-//         float), proposal parameter s);
+// data = (A: the envelope's constant part, mass: integral of f over the leaf and the disc,
+//         proposal kind (QT_PROPOSAL_*, as a float), rim exponent s);
 // box = rim proposal only: the polar box of (leaf square & disc): (cos theta at its inner
-//       radius, first azimuth, azimuth width, 0).
-#define QT_PROPOSAL_UNIFORM 0u  // uniform point in the leaf square, accept with f / M
-// Leaves cut by the rim: the proposal is the polar box of (square & disc), r in [r_a, 1],
-// phi in [phi_a, phi_a + dphi], with disc density ~ cos^-s (uniform in cos^(2-s) and phi; s = 0
-// for models bounded on the disc, s > 0 for f ~ cos^-s at the horizon: ward92 1/2, duer 1,
-// minnaert 1-k, schlick (multiple) 1, beard_maxwell 1); points outside the square are rejected;
-// accept with f cos^s / M, M bounding f cos^s (finite at the rim). Tight for rim slivers.
+//       radius, first azimuth, azimuth width, B: the envelope's cos^-s coefficient).
+// Envelope e = A (+ B cos^-s for rim leaves) >= f over (leaf & disc).
+#define QT_PROPOSAL_UNIFORM 0u  // uniform point in the leaf square, accept with f / A
+// Leaves cut by the rim: proposal over the polar box of (square & disc), r in [r_a, 1],
+// phi in [phi_a, phi_a + dphi], with disc density ~ A + B cos^-s (s = 0 and B = 0 for models
+// bounded on the disc; s > 0 for f ~ cos^-s at the horizon: ward92 1/2, duer 1, minnaert 1-k,
+// schlick (multiple) 1, beard_maxwell 1, strauss 1); points outside the square are discarded
+// before f is evaluated; accept with f / e. docs/sampler.md.
 #define QT_PROPOSAL_RIM 1u
 struct QuadLeaf {
   vec4 data;
@@ -54,7 +54,9 @@ STATIC_ASSERT_SIZE(QuadTable, 32);
 // y -> -y (applied to both directions); isotropic sets rotate the known direction to phi = 0.
 #define QT_SET_ANISOTROPIC 1u
 // Trial cap of the in-leaf rejection loop (lavapipe truncates loops silently: every loop is
-// bounded). With acceptance >= 1/n_max = 1/2 a failure has probability 2^-256.
+// bounded). A trial is one proposal draw: discarded outside (leaf & disc) with probability about
+// 1/2 at most, then accepted with probability >= 1/n_max = 1/2 in uncapped leaves, so a failure
+// has probability <= (3/4)^256 = 1e-32 there; capped leaves (measured, docs/sampler.md) can fail.
 #define QT_MAX_TRIALS 256u
 // Bound of the tree descent loop (the builder's depth cap is far below).
 #define QT_MAX_DESCENT 32u

@@ -22,7 +22,7 @@ SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint3
   out.wPdf.assign(n, vec4(0.0f));
   out.fOk.assign(n, vec4(0.0f));
   unsigned nt = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
-  std::atomic<std::uint64_t> viol{0}, fail{0}, trials{0}, evals{0};
+  std::atomic<std::uint64_t> viol{0}, fail{0}, trials{0}, evals{0}, nodeReads{0};
   std::vector<std::vector<std::uint64_t>> leafEval(nt, std::vector<std::uint64_t>(tables.leaves.size(), 0)),
       leafAcc(nt, std::vector<std::uint64_t>(tables.leaves.size(), 0));
   auto work = [&](unsigned t) {
@@ -40,6 +40,7 @@ SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint3
     fail += scope.counters().trialFailures;
     trials += scope.counters().trials;
     evals += scope.counters().evaluations;
+    nodeReads += scope.counters().nodeReads;
   };
   std::vector<std::thread> pool;
   for (unsigned t = 1; t < nt; ++t) pool.emplace_back(work, t);
@@ -49,6 +50,7 @@ SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint3
   out.trialFailures = fail;
   out.trials = trials;
   out.evaluations = evals;
+  out.nodeReads = nodeReads;
   out.leafEvaluations.assign(tables.leaves.size(), 0);
   out.leafAccepted.assign(tables.leaves.size(), 0);
   for (unsigned t = 0; t < nt; ++t)

@@ -18,6 +18,7 @@ struct SampleBatch {
   std::uint64_t boundViolations = 0, trialFailures = 0;
   std::uint64_t trials = 0;        // CPU only: rejection trials in total (proposal draws)
   std::uint64_t evaluations = 0;   // CPU only: trials that evaluated f (inside leaf & disc)
+  std::uint64_t nodeReads = 0;     // CPU only: inner nodes read by the tree descents
   std::vector<std::uint64_t> leafEvaluations, leafAccepted;  // CPU only: per leaf of `tables`
   double seconds = 0;
 };

@@ -176,9 +176,9 @@ TEST(Quadtree, ChiSquareCpu) {
       if (z < -5.3) ++leavesLow;
     }
     totalLowLeaves += leavesLow;
-    std::printf("%-48s p=%.3g chi2=%.1f dof=%d sum(pdf)=%.5f weight/a in [%.6f, %.6f] trials/sample=%.3f evals/sample=%.3f "
+    std::printf("%-48s p=%.3g chi2=%.1f dof=%d sum(pdf)=%.5f weight/a in [%.6f, %.6f] trials/sample=%.3f evals/sample=%.3f nodes/sample=%.2f "
                 "leaves=%d worst z=%.2f\n",
-                c.name().c_str(), r.pValue, r.chi2, r.dof, r.expectedTotal, lo, hi, trialsPerSample, evalsPerSample,
+                c.name().c_str(), r.pValue, r.chi2, r.dof, r.expectedTotal, lo, hi, trialsPerSample, evalsPerSample, double(b.nodeReads) / n,
                 leavesTested, worstZ);
     EXPECT_NEAR(r.expectedTotal, 1.0, 2e-3) << c.name();
     if (!qttest::knownFailure(c.name())) EXPECT_EQ(leavesLow, 0) << c.name() << ": leaves accepting below 1/n_max";
