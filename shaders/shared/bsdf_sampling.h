@@ -23,21 +23,10 @@
 // the TabSet for tabulated (the renderer stores the one of the strategy it renders with in
 // GpuMaterial.info.z); INVALID_INDEX (no tables) falls back to cosine.
 //
-// TODO(issue 5, renderer wiring of `tabulated`): the GLSL side compiles the tabulated strategy only
-// when NUSSELT_TABULATED_BUFFERS is defined; without it SAMPLER_TABULATED is cosine on the GPU.
-// To wire it: in layout.h
-//   1. #include "tabulated_layout.h" beside quadtree_layout.h;
-//   2. in the GLSL buffer_reference block:
-//        layout(buffer_reference, std430, buffer_reference_align = 16) buffer TabSets { TabSet v[]; };
-//        layout(buffer_reference, std430, buffer_reference_align = 16) buffer TabTables { TabTable v[]; };
-//   3. in Globals (after quadLeaves): BUFREF(TabSets) tabSets; BUFREF(TabTables) tabTables;
-//      BUFREF(Floats) tabData;  and the size assert 25 * 8 -> 28 * 8;
-//   4. #define NUSSELT_TABULATED_BUFFERS (e.g. right after the Globals struct);
-// in renderer.cpp: when settings.sampler == Tabulated, build
-// sampling::buildTabulatedTables(<the used non-delta materials>, TabulatedSettings{}, setOf)
-// (src/sampling/tabulated.h), store setOf[k] in materials[...].info.z, upload sets/tables/data
-// (never empty: the builder returns one dummy entry each) and set g.tabSets/tabTables/tabData;
-// then drop the fallback in Renderer::Renderer.
+// The tabulated strategy's buffers are Globals.tabSets/tabTables/tabData (layout.h, which defines
+// NUSSELT_TABULATED_BUFFERS); the renderer builds them (src/render/renderer.cpp) and stores each
+// material's TabSet where the QuadSet would go (GpuMaterial.info.z, GpuComponent.info.y). A GLSL
+// file that includes this header without layout.h compiles tabulated as cosine.
 #ifndef NUSSELT_BSDF_SAMPLING_H
 #define NUSSELT_BSDF_SAMPLING_H
 #include "brdf/dispatch.h"
@@ -57,7 +46,7 @@ SHARED_BEGIN
 #define SAMPLER_TABULATED 4u
 
 // The quadtree and tabulated samplers need the material's table set; without one they fall back
-// to cosine (so does tabulated in GLSL until its buffers exist: see the TODO above).
+// to cosine (so does tabulated in GLSL without its buffers: see above).
 SHARED_FN uint effectiveSampler(uint strategy, uint quadSet) {
 #ifndef NUSSELT_HAS_TABULATED
   if (strategy == SAMPLER_TABULATED) return SAMPLER_COSINE;

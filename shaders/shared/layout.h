@@ -6,6 +6,7 @@
 
 #include "prelude.h"
 #include "quadtree_layout.h"
+#include "tabulated_layout.h"
 
 SHARED_BEGIN
 
@@ -174,6 +175,8 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer QuadSets { 
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer QuadTables { QuadTable v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer QuadNodes { QuadNode v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer QuadLeaves { QuadLeaf v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer TabSets { TabSet v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer TabTables { TabTable v[]; };
 #endif
 
 // Per-render constants and the addresses of every buffer (buffer device addresses: no storage
@@ -217,8 +220,13 @@ struct Globals {
   BUFREF(QuadLeaves) quadLeaves;
   BUFREF(Uints) display;       // the preview's RGBA8 display buffer (0 when headless)
   BUFREF(Components) components; // the components of combined materials (GpuMaterial.components)
+  BUFREF(TabSets) tabSets;     // tabulated sampler: one set of tables per material (GpuMaterial.info.z)
+  BUFREF(TabTables) tabTables;
+  BUFREF(Floats) tabData;      // the CDFs of every table
 };
-STATIC_ASSERT_SIZE(Globals, 64 + 7 * 16 + 26 * 8);
+STATIC_ASSERT_SIZE(Globals, 64 + 7 * 16 + 29 * 8);
+// The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
+#define NUSSELT_TABULATED_BUFFERS 1
 
 // Push constants of every stage.
 struct StageConstants {

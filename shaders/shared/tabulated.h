@@ -18,8 +18,8 @@
 // phi for anisotropic sets). No interpolation between tables: the density used is exactly the one
 // of that table, so sampling is unbiased; between tables the fit is only worse.
 //
-// Buffer access: GLSL reads the buffer references of the Globals `g` (tabSets, tabTables, tabData:
-// see the TODO in bsdf_sampling.h; not in Globals yet); C++ reads host arrays through the
+// Buffer access: GLSL reads the buffer references of the Globals `g` (tabSets, tabTables, tabData,
+// layout.h); C++ reads host arrays through the
 // thread-local TabHost pointer set by TabHostScope (src/sampling/tabulated.h).
 #ifndef NUSSELT_TABULATED_H
 #define NUSSELT_TABULATED_H

@@ -3,11 +3,11 @@
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_scalar_block_layout : require
 // sample_tool: draws directions with a BSDF sampling strategy for `nusselt sample` and the GPU
-// tests. MODEL_ID and SAMPLER (SAMPLER_QUADTREE, _COSINE, _UNIFORM or _ANALYTIC; tabulated has no
-// GPU buffers yet) are specialization constants (one model and strategy per pipeline, as in shade).
+// tests. MODEL_ID and SAMPLER (SAMPLER_QUADTREE, _COSINE, _UNIFORM, _ANALYTIC or _TABULATED) are
+// specialization constants (one model and strategy per pipeline, as in shade).
 // Inputs in Globals: image.x = samples in this dispatch, image.y = index of the first one,
 // frame.y = seed, camForward.xyz = the known direction v (local frame), materials.v[0] = the
-// material (info.z = its QuadSet). Outputs per sample i: film.v[i] = (w, pdf or 0 on failure),
+// material (info.z = its QuadSet, or its TabSet for tabulated). Outputs per sample i: film.v[i] = (w, pdf or 0 on failure),
 // filmSq.v[i] = (f rgb, 1 if the sample succeeded). Counters: stats (bound violations, trial
 // failures). Sample i uses rng2(i, 0, RNG_DIM_BSDF, seed) and the rejection stream of
 // (i, 0, RNG_DIM_BSDF, seed): the CPU reproduces it bit for bit up to float differences.
@@ -35,6 +35,8 @@ void main() {
   } else {
     if (SAMPLER == SAMPLER_ANALYTIC) {
       ok = analyticSample(MODEL_ID, M.params, v, u, w, pdf);
+    } else if (SAMPLER == SAMPLER_TABULATED) {
+      ok = tabSample(M.info.z, v, u, w, pdf);
     } else if (SAMPLER == SAMPLER_UNIFORM) {
       float r = cosFromSin(u.x);
       float phi = NUSSELT_TWO_PI * u.y;

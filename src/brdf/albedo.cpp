@@ -199,6 +199,10 @@ double directionalAlbedo(std::uint32_t model, const BrdfParams& params, double t
   return hemisphere(g, thetaDeg * M_PI / 180.0, phiDeg * M_PI / 180.0, method, kRelTol);
 }
 
+double hemisphereIntegral(const std::function<double(vec3)>& g, double thetaDeg, double phiDeg, double relTol) {
+  return hemisphere(g, thetaDeg * M_PI / 180.0, phiDeg * M_PI / 180.0, AlbedoMethod::ThetaOuter, relTol);
+}
+
 void directionalAlbedoRgb(std::uint32_t model, const BrdfParams& params, double thetaDeg, double phiDeg,
                           double out[3]) {
   vec3 wi = incident(thetaDeg, phiDeg);

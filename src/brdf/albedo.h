@@ -2,6 +2,7 @@
 // tests, documentation and the tables some models keep in their parameter block (coupled).
 #pragma once
 #include <cstdint>
+#include <functional>
 
 #include "../../shaders/shared/layout.h"
 
@@ -20,6 +21,15 @@ enum class AlbedoMethod { ThetaOuter, PhiOuter };
 double directionalAlbedo(std::uint32_t model, const shared::BrdfParams& params, double thetaDeg);
 double directionalAlbedo(std::uint32_t model, const shared::BrdfParams& params, double thetaDeg, double phiDeg,
                          AlbedoMethod method = AlbedoMethod::ThetaOuter);
+
+// The same nested adaptive quadrature for any integrand: integral over the hemisphere of
+// g(w) cos(theta_w) dw, with breakpoints graded towards the mirror direction of
+// (sin t cos p, sin t sin p, cos t), t = thetaDeg, p = phiDeg, the pole and the axes.
+// (Samplers fix the second argument of f and draw the first: the albedo in their convention is
+// hemisphereIntegral(w -> lum f(w, v), theta_v), which differs from directionalAlbedo for models
+// that are not reciprocal, such as strauss.)
+double hemisphereIntegral(const std::function<double(shared::vec3)>& g, double thetaDeg, double phiDeg,
+                          double relTol = 1e-6);
 
 // Per channel (r, g, b) instead of the luminance.
 void directionalAlbedoRgb(std::uint32_t model, const shared::BrdfParams& params, double thetaDeg, double phiDeg,

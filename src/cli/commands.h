@@ -16,6 +16,8 @@ int runCli(int argc, char** argv);
 using CommandRunner = std::function<int()>;
 // `nusselt sample` and `nusselt bench precompute` (src/cli/sampler_commands.cpp).
 void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run);
+// `nusselt bench error` (src/cli/bench_error.cpp); registered by registerSamplerCommands.
+void registerBenchError(CLI::App& bench, CommandRunner& run);
 // `nusselt preview` (src/render/preview.cpp).
 void registerPreviewCommand(CLI::App& app, CommandRunner& run);
 

@@ -118,8 +118,6 @@ int sampleCommand(const SampleArgs& a) {
   if (a.thetaDeg < 0 || a.thetaDeg >= 90) throw Error("--theta must lie in [0, 90)");
   BrdfParams p = paramsFor(m, a.preset, a.params);
   const std::uint32_t strategy = strategyId(a.sampler);
-  if (strategy == SAMPLER_TABULATED && !a.cpu)
-    throw Error("--sampler tabulated: its tables have no GPU buffers yet; add --cpu");
   if (strategy != SAMPLER_QUADTREE && !a.svg.empty()) throw Error("--svg draws the quadtree: only with --sampler quadtree");
   double th = a.thetaDeg * M_PI / 180, ph = a.phiDeg * M_PI / 180;
   vec3 v(float(std::sin(th) * std::cos(ph)), float(std::sin(th) * std::sin(ph)), float(std::cos(th)));
@@ -155,7 +153,8 @@ int sampleCommand(const SampleArgs& a) {
     opts.deviceIndex = a.device;
     vk::createContext(ctx, opts);
     try {
-      b = quadtree::sampleGpu(ctx, tables, setIndex[0], m.id, p, v, a.n, a.seed, strategy);
+      b = quadtree::sampleGpu(ctx, tables, setIndex[0], m.id, p, v, a.n, a.seed, strategy,
+                             strategy == SAMPLER_TABULATED ? &tab : nullptr);
     } catch (...) {
       vk::destroyContext(ctx);
       throw;
@@ -268,7 +267,7 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
   sample->add_option("--theta-tables", sa->thetaTables, "Tables along theta")->capture_default_str()->check(CLI::Range(1u, 4096u));
   sample->add_option("--phi-tables", sa->phiTables, "Quadtree tables along phi (anisotropic models)")->capture_default_str()->check(CLI::Range(2u, 1024u));
   sample->add_option("--sampler", sa->sampler, "Strategy: quadtree, cosine, uniform, analytic (the model's own importance "
-                                               "sampling), tabulated (CPU only for now)")
+                                               "sampling), tabulated")
       ->capture_default_str()->check(CLI::IsMember({"quadtree", "cosine", "uniform", "analytic", "tabulated"}));
   sample->add_option("--tab-bytes", sa->tabBytes, "tabulated: memory budget of one table in bytes (sets the grid)")
       ->capture_default_str()->check(CLI::Range(std::uint64_t(1024), std::uint64_t(1) << 30));
@@ -282,6 +281,8 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
   pre->add_option("--phi-tables", ba->phiTables, "Tables along phi (anisotropic models)")->capture_default_str()->check(CLI::Range(2u, 1024u));
   pre->add_option("--threads", ba->threads, "Build threads (0: all cores)")->capture_default_str();
   pre->callback([ba, &run]() { run = [ba]() { return benchPrecompute(*ba); }; });
+
+  registerBenchError(bench, run);
 }
 
 }  // namespace nusselt

@@ -107,9 +107,9 @@ SampleBatch sampleCpuStrategy(std::uint32_t strategy, const sampling::TabulatedT
 }
 
 SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32_t set, std::uint32_t model,
-                      const BrdfParams& params, vec3 v, std::uint32_t n, std::uint32_t seed, std::uint32_t strategy) {
-  if (strategy == SAMPLER_TABULATED)
-    throw std::invalid_argument("sampleGpu: the tabulated strategy has no GPU buffers yet (use the CPU)");
+                      const BrdfParams& params, vec3 v, std::uint32_t n, std::uint32_t seed, std::uint32_t strategy,
+                      const sampling::TabulatedTables* tab, bool warmUp) {
+  if (strategy == SAMPLER_TABULATED && !tab) throw std::invalid_argument("sampleGpu: tabulated needs its tables");
   SampleBatch out;
   auto upload = [&](const void* data, std::size_t bytes, const char* what) {
     vk::Buffer b = vk::createBuffer(ctx, std::max<std::size_t>(bytes, 16), 0, false, what);
@@ -124,6 +124,12 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
   vk::Buffer tabs = upload(tables.tables.data(), tables.tables.size() * sizeof(QuadTable), "quadtree tables");
   vk::Buffer nodes = upload(tables.nodes.data(), tables.nodes.size() * sizeof(QuadNode), "quadtree nodes");
   vk::Buffer leaves = upload(tables.leaves.data(), tables.leaves.size() * sizeof(QuadLeaf), "quadtree leaves");
+  vk::Buffer tSets = tab ? upload(tab->sets.data(), tab->sets.size() * sizeof(TabSet), "tabulated sets")
+                         : upload(nullptr, 0, "tabulated sets");
+  vk::Buffer tTables = tab ? upload(tab->tables.data(), tab->tables.size() * sizeof(TabTable), "tabulated tables")
+                           : upload(nullptr, 0, "tabulated tables");
+  vk::Buffer tData = tab ? upload(tab->data.data(), tab->data.size() * sizeof(float), "tabulated cdfs")
+                         : upload(nullptr, 0, "tabulated cdfs");
   vk::Buffer film = vk::createBuffer(ctx, std::max<std::size_t>(n, 1) * 16, 0, true, "sample output");
   vk::Buffer filmSq = vk::createBuffer(ctx, std::max<std::size_t>(n, 1) * 16, 0, true, "sample output f");
   vk::Buffer stats = vk::createBuffer(ctx, STAT_COUNT * 4, 0, true, "sampler stats");
@@ -140,6 +146,9 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
   g.quadTables = tabs.address;
   g.quadNodes = nodes.address;
   g.quadLeaves = leaves.address;
+  g.tabSets = tSets.address;
+  g.tabTables = tTables.address;
+  g.tabData = tData.address;
 
   // Binding 0 = the Globals block, as the renderer's stages.
   vk::GlobalsBinding binding = vk::createGlobalsBinding(ctx, globals.buffer, sizeof(StageConstants));
@@ -147,6 +156,16 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
   VkDescriptorSet dset = binding.set;
   vk::ComputePipeline pipe = vk::createComputePipeline(ctx, layout, "sample_tool", {model, strategy});
 
+  if (warmUp) {  // lavapipe compiles the shader at its first dispatch: keep that out of the timing
+    g.image = uvec4(std::min<std::uint32_t>(n, WORKGROUP_SIZE), 0u, 0u, 0u);
+    std::memcpy(globals.mapped, &g, sizeof g);
+    VkCommandBuffer cmd = vk::beginOneShot(ctx);
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &dset, 0, nullptr);
+    vkCmdDispatch(cmd, 1, 1, 1);
+    vk::endOneShot(ctx, cmd);
+    std::memset(stats.mapped, 0, STAT_COUNT * 4);
+  }
   auto t0 = std::chrono::steady_clock::now();
   // Chunks of at most 65535 workgroups (maxComputeWorkGroupCount on lavapipe).
   const std::uint32_t chunk = 65535u * WORKGROUP_SIZE;
@@ -173,7 +192,7 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
 
   vk::destroyComputePipeline(ctx, pipe);
   vk::destroyGlobalsBinding(ctx, binding);
-  for (vk::Buffer* b : {&materials, &sets, &tabs, &nodes, &leaves, &film, &filmSq, &stats, &globals}) vk::destroyBuffer(ctx, *b);
+  for (vk::Buffer* b : {&materials, &sets, &tabs, &nodes, &leaves, &tSets, &tTables, &tData, &film, &filmSq, &stats, &globals}) vk::destroyBuffer(ctx, *b);
   return out;
 }
 

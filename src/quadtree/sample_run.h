@@ -33,10 +33,14 @@ SampleBatch sampleCpuStrategy(std::uint32_t strategy, const sampling::TabulatedT
                               std::uint32_t model, const shared::BrdfParams& params, shared::vec3 v, std::uint32_t n,
                               std::uint32_t seed, unsigned threads = 0);
 
-// strategy: SAMPLER_QUADTREE (default), SAMPLER_COSINE, SAMPLER_UNIFORM or SAMPLER_ANALYTIC (the
-// tabulated strategy has no GPU buffers yet).
+// strategy: SAMPLER_QUADTREE (default; `set` indexes `tables`), SAMPLER_COSINE, SAMPLER_UNIFORM,
+// SAMPLER_ANALYTIC or SAMPLER_TABULATED (needs `tab`; `set` then indexes its TabSets).
+// seconds = wall time of the dispatches alone (pipeline and buffers are made before; the first
+// dispatch includes lavapipe's lazy shader compilation unless warmUp).
+// warmUp: run one small untimed dispatch first (for benchmarks).
 SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32_t set, std::uint32_t model,
                       const shared::BrdfParams& params, shared::vec3 v, std::uint32_t n, std::uint32_t seed,
-                      std::uint32_t strategy = SAMPLER_QUADTREE);
+                      std::uint32_t strategy = SAMPLER_QUADTREE, const sampling::TabulatedTables* tab = nullptr,
+                      bool warmUp = false);
 
 }  // namespace nusselt::quadtree

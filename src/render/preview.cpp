@@ -58,7 +58,7 @@ const char* const kKeysHelp =
     "  [ and ]                          exposure down/up by half a stop; E resets it\n"
     "  T                                tone map: clamp (as `nusselt render --png`) / Reinhard\n"
     "  1 2 3 4 5                        sampling strategy: quadtree, cosine, analytic, tabulated,\n"
-    "                                   uniform (today only cosine exists; the others report so)\n"
+    "                                   uniform\n"
     "  Tab                              next available sampling strategy\n"
     "  L                                lighting estimator: mis -> nee -> bsdf\n"
     "  Space                            pause/resume accumulation\n"
@@ -68,8 +68,7 @@ const char* const kKeysHelp =
     "The title bar shows spp, samples/s, sampler, lighting, exposure and the device.";
 
 // The sampling strategies the keys 1-5 name; a key switches RenderSettings::sampler (the shade
-// stages are specialised per strategy, so the renderer is recreated). tabulated, a comparison
-// strategy of the speed-versus-error benchmark, is not wired into the renderer yet: its key says so.
+// stages are specialised per strategy, so the renderer is recreated).
 struct SamplerKey {
   const char* name;
   int key;
@@ -81,8 +80,7 @@ const SamplerKey kSamplers[] = {{"quadtree", GLFW_KEY_1},
                                 {"uniform", GLFW_KEY_5}};
 bool samplerAvailable(const std::string& name) {
   SamplerKind kind;
-  // tabulated: its tables are not wired into the renderer's buffers yet (see bsdf_sampling.h).
-  return parseSampler(name, kind) && kind != SamplerKind::Tabulated;
+  return parseSampler(name, kind);
 }
 
 

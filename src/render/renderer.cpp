@@ -11,6 +11,7 @@
 
 #include "brdf/albedo.h"
 #include "quadtree/sampler_tables.h"
+#include "sampling/tabulated.h"
 #include "scene/bvh.h"
 #include "util/error.h"
 
@@ -88,13 +89,6 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   if (settings.width == 0 || settings.height == 0) throw Error("image size must be at least 1x1");
   std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;
   if (pixels > (1ull << 28)) throw Error("image too large: at most 2^28 pixels");
-  // TODO(issue 5): the tabulated strategy's tables have no GPU buffers yet (the wiring steps are in
-  // shaders/shared/bsdf_sampling.h); until then a render that asks for it samples with cosine.
-  if (m_settings.sampler == SamplerKind::Tabulated) {
-    std::fprintf(stderr, "error: sampler tabulated is not wired into the renderer yet (its tables have no GPU "
-                         "buffers): rendering with cosine sampling instead\n");
-    m_settings.sampler = SamplerKind::Cosine;
-  }
   // One indirect dispatch covers a whole queue: its group count must stay <= 65535.
   std::uint32_t maxChunk = std::min<std::uint32_t>(settings.maxPathsPerChunk, 65535u * WORKGROUP_SIZE);
   m_capacity = static_cast<std::uint32_t>(std::min<std::uint64_t>(pixels, maxChunk));
@@ -361,7 +355,9 @@ void Renderer::uploadScene(const Scene& scene) {
   // components of combined materials) the scene uses; identical (model, params) share a set ----
   std::vector<std::pair<std::uint32_t, shared::BrdfParams>> toBuild;
   std::vector<std::uint32_t*> builtSet;  // where each built set's index goes
-  if (m_settings.sampler == SamplerKind::Quadtree)
+  // The tabulated strategy's tables go to the very same places (GpuMaterial.info.z, GpuComponent.info.y):
+  // the shade stage passes that index to bsdfSample as the set of the strategy it is specialised for.
+  if (m_settings.sampler == SamplerKind::Quadtree || m_settings.sampler == SamplerKind::Tabulated)
     for (std::size_t i = 0; i < scene.materials.size(); ++i) {
       if (!materialUsed[i]) continue;
       const Material& m = scene.materials[i];
@@ -376,7 +372,19 @@ void Renderer::uploadScene(const Scene& scene) {
         }
     }
   quadtree::SamplerTables qt;
-  if (!toBuild.empty()) {
+  sampling::TabulatedTables tab;
+  if (!toBuild.empty() && m_settings.sampler == SamplerKind::Tabulated) {
+    // Memory budget: the default 64 KiB per table (90 x 180 cells; docs/strategies.md). Sizing each
+    // material's tables like its quadtree (bytesPerTableLike) would need the quadtree built first
+    // (seconds to minutes per material when the cache is cold), so renders use the default.
+    std::vector<std::uint32_t> setOf;
+    tab = sampling::buildTabulatedTables(toBuild, sampling::TabulatedSettings{}, setOf);
+    for (std::size_t k = 0; k < builtSet.size(); ++k) *builtSet[k] = setOf[k];
+    m_summary.samplerSeconds = tab.seconds;
+    m_summary.samplerTrees = static_cast<std::uint32_t>(tab.tables.size());
+    m_summary.samplerBytes = tab.bytes();
+    vk::uploadBuffer(m_ctx, *materialBuffer, materials.data(), materials.size() * sizeof(GpuMaterial));
+  } else if (!toBuild.empty()) {
     std::vector<std::uint32_t> setOf;
     qt = quadtree::buildSamplerTables(toBuild, quadtree::QuadtreeSettings{}, setOf);
     for (std::size_t k = 0; k < builtSet.size(); ++k) *builtSet[k] = setOf[k];
@@ -393,7 +401,8 @@ void Renderer::uploadScene(const Scene& scene) {
   // wo keeps the estimator unbiased, the albedo keeps the weights near 1). Floored at 1e-4 so
   // that no component whose BRDF is not zero is ever left unsampled.
   for (GpuComponent& c : components) {
-    if (modelById(c.info.x).delta || c.info.y != INVALID_INDEX) continue;
+    // (Only quadtree components read their albedo from their set: tabulated ones use this table too.)
+    if (modelById(c.info.x).delta || (m_settings.sampler == SamplerKind::Quadtree && c.info.y != INVALID_INDEX)) continue;
     float table[COMPONENT_ALBEDO_NODES];
     for (std::uint32_t n = 0; n < COMPONENT_ALBEDO_NODES; ++n) {
       double cosTheta = std::max(double(n) / (COMPONENT_ALBEDO_NODES - 1), 0.02);
@@ -413,6 +422,9 @@ void Renderer::uploadScene(const Scene& scene) {
   g.quadTables = make(orOne(qt.tables) * sizeof(shared::QuadTable), "quadtree tables", qt.tables.data())->address;
   g.quadNodes = make(orOne(qt.nodes) * sizeof(shared::QuadNode), "quadtree nodes", qt.nodes.data())->address;
   g.quadLeaves = make(orOne(qt.leaves) * sizeof(shared::QuadLeaf), "quadtree leaves", qt.leaves.data())->address;
+  g.tabSets = make(orOne(tab.sets) * sizeof(shared::TabSet), "tabulated sets", tab.sets.data())->address;
+  g.tabTables = make(orOne(tab.tables) * sizeof(shared::TabTable), "tabulated tables", tab.tables.data())->address;
+  g.tabData = make(orOne(tab.data) * sizeof(float), "tabulated cdfs", tab.data.data())->address;
   g.display = 0;
 
   // Film starts at zero.

@@ -234,7 +234,7 @@ fi
   ok "camera keys move the view and R restores it (4 spp after the reset = headless 4 spp)" ||
   fail "after R: $("$nusselt" diff "$work/reset.exr" "$work/render4.exr")"
 # S saves EXR + PNG in the current directory; L switches the estimator (a new Renderer); key 3
-# switches to the analytic sampler (a new Renderer; tabulated is not available yet); exposure and
+# switches to the analytic sampler (a new Renderer); exposure and
 # tone map keys.
 mkdir -p "$work/cwd"
 (cd "$work/cwd" && "$nusselt" preview --width $W --height $H --frames 12 --test-keys S,L,3,Tab,],T,S \

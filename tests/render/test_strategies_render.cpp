@@ -1,0 +1,66 @@
+// The five BSDF sampling strategies render the same image: tabulated (piecewise-constant tables,
+// inverse-CDF sampling), analytic (the model's own importance sampling), cosine, uniform and the
+// quadtree are unbiased estimators of one integral, so their renders of a glossy scene agree
+// within their statistical error. Per block of 8x8 pixels a Welch z-test (the renders' own
+// variances), cell alpha 0.01 with a binomial bound on failing blocks at alpha 0.001 per
+// comparison (test_mis.cpp's test), fixed seeds; thresholds come from the statistics, never tuned.
+#include <gtest/gtest.h>
+
+#include "../support/test_support.h"
+#include "brdf/registry.h"
+
+using namespace nusselt;
+
+namespace {
+
+MaterialComponent component(const std::string& model, float weight) {
+  MaterialComponent c;
+  c.model = findModel(model)->id;
+  c.weight = weight;
+  c.params = packParams(*findModel(model), typicalParams(*findModel(model)), model);
+  return c;
+}
+
+// The MIS test scene (a floor under a large dim and a small bright light) with a glossy floor:
+// one model, or a combination (exercises the tables of combined materials' components).
+Scene glossyScene(const std::vector<MaterialComponent>& components) {
+  Scene scene = test::loadTestScene("scenes/tests/mis.gltf");
+  Material& floor = scene.materials[0];
+  floor.model = components[0].model;
+  floor.params = components[0].params;
+  if (components.size() > 1) floor.components = components;
+  return scene;
+}
+
+void expectStrategiesAgree(const Scene& scene) {
+  RenderSettings s;
+  s.width = 64;
+  s.height = 64;
+  s.spp = 128;
+  s.maxDepth = 3;
+  s.sampler = SamplerKind::Tabulated;
+  s.seed = 21;
+  test::Rendered tab = test::render(scene, s);
+  EXPECT_EQ(tab.stats.nonFiniteSamples, 0u);
+  double sum = 0;
+  for (float v : tab.image.rgb) sum += v;
+  EXPECT_GT(sum, 0.0);  // not black: the comparison would pass vacuously
+  std::uint32_t seed = 22;
+  for (SamplerKind k : {SamplerKind::Analytic, SamplerKind::Cosine, SamplerKind::Quadtree}) {
+    s.sampler = k;
+    s.seed = seed++;
+    test::Rendered other = test::render(scene, s);
+    EXPECT_EQ(other.stats.nonFiniteSamples, 0u);
+    std::string m = test::compareImagesStatistically(other.image, tab.image, 0.01, 0.001, 8);
+    EXPECT_TRUE(m.empty()) << samplerName(k) << " vs tabulated: " << m;
+  }
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+}  // namespace
+
+TEST(StrategiesRender, TabulatedAnalyticCosineQuadtreeAgree) { expectStrategiesAgree(glossyScene({component("blinn", 1.0f)})); }
+
+TEST(StrategiesRender, CombinedMaterialAgrees) {
+  expectStrategiesAgree(glossyScene({component("lambert", 0.5f), component("phong", 0.5f)}));
+}
