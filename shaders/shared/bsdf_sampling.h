@@ -45,6 +45,21 @@ SHARED_BEGIN
 #define SAMPLER_ANALYTIC 3u
 #define SAMPLER_TABULATED 4u
 
+// The shade stage is compiled once per strategy (NUSSELT_SHADE_SAMPLER = its id, CMakeLists.txt):
+// only that strategy's code and the cosine fallback are in the module. C++ and the other stages
+// have all of them.
+#ifdef NUSSELT_SHADE_SAMPLER
+#define NUSSELT_WITH_QUADTREE (NUSSELT_SHADE_SAMPLER == 0)
+#define NUSSELT_WITH_UNIFORM (NUSSELT_SHADE_SAMPLER == 2)
+#define NUSSELT_WITH_ANALYTIC (NUSSELT_SHADE_SAMPLER == 3)
+#define NUSSELT_WITH_TABULATED (NUSSELT_SHADE_SAMPLER == 4)
+#else
+#define NUSSELT_WITH_QUADTREE 1
+#define NUSSELT_WITH_UNIFORM 1
+#define NUSSELT_WITH_ANALYTIC 1
+#define NUSSELT_WITH_TABULATED 1
+#endif
+
 // The quadtree and tabulated samplers need the material's table set; without one they fall back
 // to cosine (so does tabulated in GLSL without its buffers: see above).
 SHARED_FN uint effectiveSampler(uint strategy, uint quadSet) {
@@ -58,10 +73,16 @@ SHARED_FN uint effectiveSampler(uint strategy, uint quadSet) {
 SHARED_FN float bsdfPdf(uint strategy, uint model, uint quadSet, BrdfParams p, vec3 wo, vec3 wi) {
   if (wo.z <= 0.0f || wi.z <= 0.0f || modelIsDelta(model)) return 0.0f;
   uint s = effectiveSampler(strategy, quadSet);
+#if NUSSELT_WITH_QUADTREE
   if (s == SAMPLER_QUADTREE) return quadPdf(quadSet, model, p, wo, wi);
+#endif
+#if NUSSELT_WITH_UNIFORM
   if (s == SAMPLER_UNIFORM) return 0.5f * NUSSELT_INV_PI;
+#endif
+#if NUSSELT_WITH_ANALYTIC
   if (s == SAMPLER_ANALYTIC) return analyticPdf(model, p, wo, wi);
-#ifdef NUSSELT_HAS_TABULATED
+#endif
+#if defined(NUSSELT_HAS_TABULATED) && NUSSELT_WITH_TABULATED
   if (s == SAMPLER_TABULATED) return tabPdf(quadSet, wo, wi);
 #endif
   return cosineHemispherePdf(wi);
@@ -103,6 +124,7 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
     return true;
   }
   uint s = effectiveSampler(strategy, quadSet);
+#if NUSSELT_WITH_QUADTREE
   if (s == SAMPLER_QUADTREE) {
     vec3 f;
     if (!quadSample(quadSet, model, p, wo, u, rngKey, wi, pdf, f) || !(pdf > 0.0f)) return false;
@@ -113,21 +135,27 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
     continuation = min(1.0f, quadAlbedo(quadSet, wo.z, portableAtan2(wo.y, wo.x)));
     return true;
   }
+#endif
   float cont = -1.0f;  // < 0: min(1, luminance(weight))
-  if (s == SAMPLER_ANALYTIC) {
+  if (false) {
+#if NUSSELT_WITH_ANALYTIC
+  } else if (s == SAMPLER_ANALYTIC) {
     if (!analyticSample(model, p, wo, u, wi, pdf)) return false;
-#ifdef NUSSELT_HAS_TABULATED
+#endif
+#if defined(NUSSELT_HAS_TABULATED) && NUSSELT_WITH_TABULATED
   } else if (s == SAMPLER_TABULATED) {
     if (!tabSample(quadSet, wo, u, wi, pdf)) return false;
     float a = tabAlbedo(quadSet, wo);
     if (a > 0.0f) cont = min(1.0f, a);
 #endif
+#if NUSSELT_WITH_UNIFORM
   } else if (s == SAMPLER_UNIFORM) {
     float z = u.x;
     float r = cosFromSin(z);
     float phi = NUSSELT_TWO_PI * u.y;
     wi = vec3(r * cos(phi), r * sin(phi), z);
     pdf = 0.5f * NUSSELT_INV_PI;
+#endif
   } else {
     wi = squareToCosineHemisphere(u);
     pdf = cosineHemispherePdf(wi);

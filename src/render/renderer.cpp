@@ -515,7 +515,9 @@ void Renderer::createPipelines() {
             spec.push_back(key[0]);
             for (std::uint32_t k = 0; k < MAX_COMPONENTS; ++k) spec.push_back(k < key[0] ? key[1 + k] : key[1]);
           }
-          m_shade[s] = vk::createComputePipeline(m_ctx, m_pipelineLayout, "shade", spec);
+          // One module per strategy (CMakeLists.txt): shade_sN / shade_combined_sN.
+          const std::string module = std::string(key[0] > 0 ? "shade_combined" : "shade") + "_s" + std::to_string(sampler);
+          m_shade[s] = vk::createComputePipeline(m_ctx, m_pipelineLayout, module, spec);
         } catch (const std::exception& e) {
           errors[s] = e.what();
         }

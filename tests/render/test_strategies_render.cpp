@@ -34,8 +34,8 @@ Scene glossyScene(const std::vector<MaterialComponent>& components) {
 
 void expectStrategiesAgree(const Scene& scene) {
   RenderSettings s;
-  s.width = 64;
-  s.height = 64;
+  s.width = 32;  // 8 x 8 blocks of 4 x 4 pixels, 2048 samples per block and strategy
+  s.height = 32;
   s.spp = 128;
   s.maxDepth = 3;
   s.sampler = SamplerKind::Tabulated;

@@ -1,0 +1,4 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#define SHADE_COMBINED 1
+#include "stages/shade_body.glsl"
