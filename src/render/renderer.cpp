@@ -386,7 +386,10 @@ void Renderer::uploadScene(const Scene& scene) {
     vk::uploadBuffer(m_ctx, *materialBuffer, materials.data(), materials.size() * sizeof(GpuMaterial));
   } else if (!toBuild.empty()) {
     std::vector<std::uint32_t> setOf;
-    qt = quadtree::buildSamplerTables(toBuild, quadtree::QuadtreeSettings{}, setOf);
+    quadtree::QuadtreeSettings qs;
+    qs.thetaTables = std::max(1u, m_settings.samplerThetaTables);
+    qs.phiTables = std::max(2u, m_settings.samplerPhiTables);
+    qt = quadtree::buildSamplerTables(toBuild, qs, setOf);
     for (std::size_t k = 0; k < builtSet.size(); ++k) *builtSet[k] = setOf[k];
     m_summary.samplerSeconds = qt.seconds;
     m_summary.samplerTrees = static_cast<std::uint32_t>(qt.tables.size());
@@ -478,6 +481,13 @@ void Renderer::reset() {
 void Renderer::setCamera(const Camera& camera) {
   m_cameraState = camera;
   writeCamera(camera);
+  reset();
+}
+
+void Renderer::setLighting(LightingMode mode) {
+  m_settings.lighting = mode;
+  reinterpret_cast<Globals*>(m_globals.data())->counts.w = static_cast<std::uint32_t>(mode);
+  std::memcpy(m_globalsBuffer.mapped, m_globals.data(), sizeof(Globals));
   reset();
 }
 

@@ -42,6 +42,12 @@ struct RenderSettings {
   RngMode rng = RngMode::Pcg;
   SamplerKind sampler = SamplerKind::Quadtree;  // the generic sampler of Montes et al.
   ComponentSelection components = ComponentSelection::Albedo;  // combined materials only
+  // The quadtree sampler's table counts (quadtree::QuadtreeSettings; the paper's 90 and 16 by
+  // default; phi only for anisotropic sets). Fewer tables build faster (the hard-case tests use
+  // 18 x 4 for the anisotropic hard sets, whose 1440 trees take minutes) at the cost of a coarser
+  // grid in the outgoing direction: a looser fit between tables, more variance.
+  std::uint32_t samplerThetaTables = 90;
+  std::uint32_t samplerPhiTables = 16;
   // Sample indices of this render start here (`--spp-offset`): a frame can be split across
   // machines into disjoint sample ranges and merged (`nusselt merge`).
   std::uint32_t sampleOffset = 0;
@@ -106,6 +112,9 @@ class Renderer {
   void reset();
   // Move the camera; restarts accumulation.
   void setCamera(const Camera& camera);
+  // Change the lighting estimator (a run-time value of the shaders: no pipeline is rebuilt);
+  // restarts accumulation. Statistics keep accumulating.
+  void setLighting(LightingMode mode);
   const Camera& camera() const { return m_cameraState; }
   // Extra stages (e.g. the preview's display stage) run with the renderer's pipeline layout and
   // descriptor set, so they see the same Globals; Globals.display is theirs to point at a buffer.

@@ -20,6 +20,11 @@ attr() { "$nusselt" info "$1" | sed -n "s/^  nusselt\/$2: //p"; }
 [ -n "$(attr "$work/a.exr" version)" ] || fail "version attribute"
 [ -n "$(attr "$work/a.exr" integrator)" ] || fail "integrator attribute"
 [ -n "$(attr "$work/a.exr" renderSeconds)" ] || fail "renderSeconds attribute"
+# The robustness counters (issue 8): dropped non-finite samples and the quadtree sampler's bound
+# violations are in every header, and 0 for the default scene.
+[ "$(attr "$work/a.exr" nonFiniteSamples)" = 0 ] || fail "nonFiniteSamples attribute: '$(attr "$work/a.exr" nonFiniteSamples)'"
+[ "$(attr "$work/a.exr" samplerBoundViolations)" = 0 ] || fail "samplerBoundViolations attribute"
+[ -n "$(attr "$work/a.exr" samplerTrialFailures)" ] || fail "samplerTrialFailures attribute"
 "$nusselt" info "$work/a.exr" | head -1 | grep -q "16x12" || fail "image size"
 
 # Same seed: identical pixels (the header differs only in timings).

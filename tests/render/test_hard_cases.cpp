@@ -1,28 +1,45 @@
 // Numerical hard cases (issue 8). Each test is named after what it provokes. Every render must
 // come out without a NaN or Inf pixel; samples that would have been non-finite are dropped and
 // counted by the accumulate stage (RenderStats::nonFiniteSamples, the EXR header's count), and
-// the count must be 0 wherever the input is valid. Images are tiny (<= 24x24) so the suite stays
-// well under a minute on lavapipe.
+// the count must be 0 wherever the input is valid. Quadtree-sampler bound violations
+// (RenderStats::samplerBoundViolations) are asserted to be 0 in every render. Images are tiny
+// (<= 16x16): a case's cost is lavapipe creating the renderer's pipelines (~4 s per renderer
+// here, not cached across renderers by Mesa 22.3) and, for the catalogue, building the quadtrees.
 //
-// Models: the cases below run on lambert (including its catalogue hard set rho = 1), dielectric
-// (a light inside glass), area lights and punctual lights. HardSetsOfTheCatalogue is a
-// parameterised test over kReadyModels; add a model name there when its case is affordable in CI
-// time. Run by hand (3 lighting modes each, 16x16, 8 spp): phong_specular, phong, lewis, blinn,
-// torrance_sparrow, lafortune, minnaert and oren_nayar pass in 3-12 s; ward and
-// ashikhmin_shirley pass but take ~100 s; schlick did not finish within 400 s; strauss,
-// beard_maxwell, htsg, poulin_fournier, coupled, gltf_pbr and mirror are still to be run.
-// Quadtree-sampler bound violations (RenderStats::samplerBoundViolations) are asserted to be 0 in
-// every render; the sampler's own hard cases belong with it.
+// HardSetsOfTheCatalogue runs every model of the catalogue (18 non-delta, plus mirror and
+// dielectric) with its hard parameter set at grazing view and light angles, MIS / NEE / BSDF.
+// Measured (cold tree cache: NUSSELT_CACHE_DIR=<empty dir>, NUSSELT_VALIDATION=1,
+// `render_tests --gtest_filter='HardCases.*:Catalogue/*'`, 2 cores shared with other test runs;
+// seconds per test as gtest printed them, trees = quadtree build within that):
+//   lambert 4.5, phong_specular 6.3, phong 6.6, lewis 6.7, blinn 8.3, torrance_sparrow 6.7,
+//   ward 10.1 (18x4 tables), ashikhmin_shirley 10.0 (18x4), lafortune 9.6, minnaert 4.1,
+//   oren_nayar 5.0, strauss 6.8, beard_maxwell 4.9, htsg 21.7 (18 tables; trees 15 s),
+//   coupled 14.9 (trees 10-12 s), gltf_pbr 5.1, mirror 3.9, dielectric 4.4: 140 s in all.
+//   Skipped unless NUSSELT_HARD_CASES_SLOW=1 (18x4 tables): schlick 135 s (trees 131 s; 243 s
+//   under heavier load), poulin_fournier 109 s (trees 105 s; 263 s under heavier load).
+//   The other tests: loader NaN/Inf 4.1, direct NaN/Inf normals 4.1, slivers 8.2, scales 26.6,
+//   camera inside 4.6 (one renderer; 18.2 with four), emitters 8.5, depth cap 17.1, punctual
+//   grazing 21.5, light in glass 9.3: ~104 s. The whole file: 257 s with a cold tree cache
+//   (before CameraInsideGeometry shared its renderer: ~243 s now); 178 s with a warm one
+//   (~/.cache/nusselt kept between CI runs; every catalogue case is then 3.9-4.7 s, 76 s in all).
+// Results: nonFiniteSamples 0 and samplerBoundViolations 0 everywhere; samplerTrialFailures 0
+// except the known failures beard_maxwell (11 per 8-spp image) and schlick (2, slow run);
+// poulin_fournier and gltf_pbr, also listed as known failures, had 0.
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <string>
 #include <vector>
 
 #include "../support/test_support.h"
+#include "../unit/test_quadtree_chi2.h"
 #include "scene/gltf_loader.h"
 
 using namespace nusselt;
@@ -313,14 +330,27 @@ TEST(HardCases, CameraInsideGeometry) {
   s.lights.push_back(l);
   s.hasCamera = true;
   s.camera = perspective(glm::vec3(0.1f, 0.2f, 0.3f), {1, 0.3f, -0.2f}, {0, 0, 1}, 2.5f);
-  test::Rendered inside = test::render(s, tiny(8, 4));
+  // One renderer, the camera moved between images (pipeline creation is most of the cost).
+  const RenderSettings settings = tiny(8, 4);
+  Renderer renderer(test::context(), s, settings);
+  RenderStats before = renderer.stats();
+  auto next = [&] {
+    for (std::uint32_t i = 0; i < settings.spp; ++i) renderer.renderPass();
+    test::Rendered r{renderer.image(true), renderer.stats(), renderer.summary()};
+    r.stats.nonFiniteSamples -= before.nonFiniteSamples;
+    r.stats.samplerBoundViolations -= before.samplerBoundViolations;
+    r.stats.bvhStackOverflows -= before.bvhStackOverflows;
+    before = renderer.stats();
+    return r;
+  };
+  test::Rendered inside = next();
   EXPECT_EQ(expectSane(inside, "inside"), 0u);
   EXPECT_EQ(meanOf(inside.image), 0.0) << "light leaked into a closed box";
 
   // Camera on the +x face of the block, looking out and looking along the face.
   for (glm::vec3 forward : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0), glm::vec3(-1, 0, 0)}) {
-    s.camera = perspective(glm::vec3(1.0f, 0.0f, 0.0f), forward, {0, 0, 1});
-    test::Rendered on = test::render(s, tiny(8, 4));
+    renderer.setCamera(perspective(glm::vec3(1.0f, 0.0f, 0.0f), forward, {0, 0, 1}));
+    test::Rendered on = next();
     EXPECT_EQ(expectSane(on, "onSurface"), 0u);
   }
 }
@@ -469,35 +499,132 @@ TEST(HardCases, LightInsideGlass) {
 
 // ---- The catalogue's hard parameter sets ----
 
-// Every model ready in the renderer, with its catalogue hard set, on a floor lit by a small area
-// light and a grazing point light, viewed from a grazing angle.
-class HardSetsOfTheCatalogue : public ::testing::TestWithParam<const char*> {};
+// Every model of the catalogue with its hard set (extreme shininess, tiny lobes, grazing-heavy
+// Fresnel) on a large floor seen from 0.1 above it: the image rows below the horizon see the
+// floor at view angles from 78.5 deg to within 0.1 deg of 90 deg. It is lit by a 1 x 1 area light
+// 1.5 above (which the far floor sees at 80-89 deg) and by a point light 1e-3 above the floor
+// (89.98 deg at 3 units) whose mirror reflection is in view, under a uniform sky of radiance 0.5;
+// rendered under MIS, NEE only and BSDF sampling only (one renderer, setLighting between them). Asserted per render: no NaN/Inf pixel or variance, nonFiniteSamples == 0,
+// samplerBoundViolations == 0, no BVH overflow or validation message, and samplerTrialFailures
+// == 0 unless the model's hard set is a known failure of the sampler
+// (tests/unit/test_quadtree_chi2.h knownFailures(): rare trial failures at grazing angles), in
+// which case the count is printed and not asserted.
+namespace {
 
-// Add a model here when its case fits the CI time budget (see the top of this file).
-const char* const kReadyModels[] = {"lambert"};
+struct HardCase {
+  const char* model;
+  std::uint32_t thetaTables = 90, phiTables = 16;
+  // Skipped unless NUSSELT_HARD_CASES_SLOW=1: the quadtree build alone exceeds the CI budget.
+  const char* slow = nullptr;
+};
 
-TEST_P(HardSetsOfTheCatalogue, GrazingViewAndLights) {
-  const ModelSpec* spec = findModel(GetParam());
-  ASSERT_NE(spec, nullptr);
+class HardSetsOfTheCatalogue : public ::testing::TestWithParam<HardCase> {};
+
+// Tables: the renderer's default 90 x 16 where the build is cheap. The anisotropic hard sets (ward
+// ax != ay, ashikhmin_shirley nu != nv, schlick p < 1, poulin_fournier) would need 90 x 16 = 1440
+// trees: ward's took 117 s to build here, against 1-4 s for the 90 trees of most isotropic sets.
+// They use the chi-square tests' 18 x 4 tables (72 trees: 5 deg x 30 deg steps), as does htsg
+// (isotropic, but its 90 trees took 91 s). Build times with a cold tree cache on 2 lavapipe
+// cores shared with other test runs (see the top of this file).
+const HardCase kHardCases[] = {
+    {"lambert"}, {"phong_specular"}, {"phong"}, {"lewis"}, {"blinn"}, {"torrance_sparrow"}, {"ward", 18, 4},
+    {"ashikhmin_shirley", 18, 4}, {"lafortune"}, {"minnaert"}, {"oren_nayar"},
+    {"schlick", 18, 4, "its 72 trees of 18 x 4 tables took 130-236 s to build (r = 0.002, multiple reflections)"},
+    {"strauss"}, {"beard_maxwell"}, {"htsg", 18},
+    {"poulin_fournier", 18, 4, "its 72 trees of 18 x 4 tables took 105-258 s to build"},
+    {"coupled"}, {"gltf_pbr"},
+    // Delta models (no quadtree, never light-sampled): Fresnel at grazing incidence.
+    {"mirror"}, {"dielectric"},
+};
+
+bool slowCasesEnabled() {
+  const char* e = std::getenv("NUSSELT_HARD_CASES_SLOW");
+  return e && std::string(e) != "0";
+}
+
+// True when a known failure of the sampler's chi-square matrix names this model's hard set
+// ("schlick/hard", or a narrower "gltf_pbr/hard/theta=85").
+bool knownTrialFailures(const std::string& model) {
+  const std::string name = model + "/hard";
+  for (const qttest::KnownFailure& k : qttest::knownFailures())
+    if (std::string(k.prefix).rfind(name, 0) == 0) return true;
+  return false;
+}
+
+// The scene of HardSetsOfTheCatalogue (below) for one model's hard set.
+Scene grazingScene(const ModelSpec& spec) {
   Scene s;
-  std::uint32_t m = addMaterial(s, withModel(spec->name, hardParams(*spec)));
-  std::uint32_t lamp = addMaterial(s, lambert(0.0f, glm::vec3(20.0f), "lamp"));
-  addQuad(s, {-2, -2, 0}, {2, -2, 0}, {2, 2, 0}, {-2, 2, 0}, m);
-  addQuad(s, {-0.1f, -0.1f, 1.5f}, {-0.1f, 0.1f, 1.5f}, {0.1f, 0.1f, 1.5f}, {0.1f, -0.1f, 1.5f}, lamp);
+  // The lamp is the same material plus emission: one shade pipeline and one quadtree set per case
+  // (lavapipe compiles each shade pipeline for seconds; that, not the render, is the case's cost).
+  Material floor = withModel(spec.name, hardParams(spec));
+  Material lamp = floor;
+  lamp.name = "lamp";
+  lamp.emission = glm::vec3(5.0f);
+  addQuad(s, {-200, -200, 0}, {200, -200, 0}, {200, 200, 0}, {-200, 200, 0}, addMaterial(s, floor));
+  addQuad(s, {-0.5f, -0.5f, 1.5f}, {-0.5f, 0.5f, 1.5f}, {0.5f, 0.5f, 1.5f}, {0.5f, -0.5f, 1.5f}, addMaterial(s, lamp));
   PunctualLight l;
   l.position = {3.0f, 0.0f, 1e-3f};
   l.intensity = glm::vec3(100.0f);
   s.lights.push_back(l);
   s.hasCamera = true;
-  s.camera = perspective({-3.0f, 0.0f, 0.02f}, {1, 0, -0.004f}, {0, 0, 1}, 0.6f);
-  for (LightingMode mode : {LightingMode::Mis, LightingMode::NeeOnly, LightingMode::BsdfOnly}) {
-    SCOPED_TRACE(lightingModeName(mode));
-    RenderSettings settings = tiny(8, 4);
-    settings.lighting = mode;
-    test::Rendered r = test::render(s, settings);
-    EXPECT_EQ(expectSane(r, spec->name.c_str()), 0u);
-  }
+  // Rows from 0.1 rad above the horizon to 0.2 rad below it (yfov 0.3 around 0.05 rad down).
+  s.camera = perspective({-3.0f, 0.0f, 0.1f}, {1, 0, -0.05f}, {0, 0, 1}, 0.3f);
+  // A uniform sky: BSDF-sampled directions that escape carry light (the mirror and the glass
+  // reflect it at grazing; the sharp lobes would otherwise see almost nothing).
+  s.background = glm::vec3(0.5f);
+  return s;
 }
 
-INSTANTIATE_TEST_SUITE_P(ReadyModels, HardSetsOfTheCatalogue, ::testing::ValuesIn(kReadyModels),
-                         [](const ::testing::TestParamInfo<const char*>& info) { return std::string(info.param); });
+}  // namespace
+
+TEST_P(HardSetsOfTheCatalogue, GrazingViewAndLights) {
+  const HardCase& c = GetParam();
+  const ModelSpec* spec = findModel(c.model);
+  ASSERT_NE(spec, nullptr);
+  if (c.slow && !slowCasesEnabled())
+    GTEST_SKIP() << spec->name << ": " << c.slow << "; NUSSELT_HARD_CASES_SLOW=1 runs it";
+  const bool known = knownTrialFailures(spec->name);
+  Scene s = grazingScene(*spec);
+  RenderSettings settings = tiny(8, 4);
+  settings.samplerThetaTables = c.thetaTables;
+  settings.samplerPhiTables = c.phiTables;
+  const auto t0 = std::chrono::steady_clock::now();
+  // One renderer (pipelines and trees built once), the three estimators in turn.
+  Renderer renderer(test::context(), s, settings);
+  const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const SceneSummary& summary = renderer.summary();
+  std::printf("[ hard set ] %-17s setup %6.2f s (pipelines %.2f s; %u trees of %ux%u tables in %.2f s, cache hits %u)\n",
+              spec->name.c_str(), setup, summary.pipelineSeconds, summary.samplerTrees, c.thetaTables,
+              summary.samplerTrees / c.thetaTables, summary.samplerSeconds, summary.samplerCacheHits);
+  RenderStats before = renderer.stats();
+  for (LightingMode mode : {LightingMode::Mis, LightingMode::NeeOnly, LightingMode::BsdfOnly}) {
+    SCOPED_TRACE(lightingModeName(mode));
+    const auto r0 = std::chrono::steady_clock::now();
+    renderer.setLighting(mode);
+    for (std::uint32_t i = 0; i < settings.spp; ++i) renderer.renderPass();
+    test::Rendered r{renderer.image(true), renderer.stats(), summary};
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
+    // This mode's counts: the renderer's statistics accumulate over the three.
+    r.stats.nonFiniteSamples -= before.nonFiniteSamples;
+    r.stats.samplerBoundViolations -= before.samplerBoundViolations;
+    r.stats.samplerTrialFailures -= before.samplerTrialFailures;
+    r.stats.bvhStackOverflows -= before.bvhStackOverflows;
+    before = renderer.stats();
+    const std::string what = spec->name + "_" + lightingModeName(mode);
+    EXPECT_EQ(expectSane(r, what.c_str()), 0u) << "nonFiniteSamples";
+    std::printf("[ hard set ] %-17s %-5s %6.2f s  mean %.3g  nonFinite %llu  boundViolations %llu  trialFailures %llu%s\n",
+                spec->name.c_str(), lightingModeName(mode), seconds, meanOf(r.image),
+                static_cast<unsigned long long>(r.stats.nonFiniteSamples),
+                static_cast<unsigned long long>(r.stats.samplerBoundViolations),
+                static_cast<unsigned long long>(r.stats.samplerTrialFailures),
+                known ? " (known sampler failure: not asserted)" : "");
+    ::testing::Test::RecordProperty("samplerTrialFailures_" + what, std::to_string(r.stats.samplerTrialFailures));
+    if (!known) EXPECT_EQ(r.stats.samplerTrialFailures, 0u) << spec->name << " is not a known failure";
+  }
+  std::printf("[ hard set ] %-17s total %6.2f s\n", spec->name.c_str(),
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  std::fflush(stdout);
+}
+
+INSTANTIATE_TEST_SUITE_P(Catalogue, HardSetsOfTheCatalogue, ::testing::ValuesIn(kHardCases),
+                         [](const ::testing::TestParamInfo<HardCase>& info) { return std::string(info.param.model); });

@@ -45,7 +45,7 @@ void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::
 Rendered render(const Scene& scene, const RenderSettings& settings) {
   Renderer r(context(), scene, settings);
   for (std::uint32_t i = 0; i < settings.spp; ++i) r.renderPass();
-  return {r.image(true), r.stats()};
+  return {r.image(true), r.stats(), r.summary()};
 }
 
 void runKernel(const std::string& name, const std::vector<std::uint32_t>& specialization, const void* push,

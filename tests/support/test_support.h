@@ -25,6 +25,7 @@ void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::
 struct Rendered {
   Image image;  // with variance of the mean per channel
   RenderStats stats;
+  SceneSummary summary;  // pipeline and quadtree build times, cache hits
 };
 Rendered render(const Scene& scene, const RenderSettings& settings);
 
