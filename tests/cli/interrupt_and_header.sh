@@ -36,7 +36,10 @@ for sig in INT TERM; do
   out=$work/int_$sig.exr
   "$nusselt" render -o "$out" --width 32 --height 32 --spp 1000000 2>"$work/stderr_$sig" &
   pid=$!
-  sleep 4
+  # Interrupt once the render loop runs (the setup time varies with the machine's load), plus
+  # enough time for a few passes.
+  for _ in $(seq 600); do grep -q '^device:' "$work/stderr_$sig" 2>/dev/null && break; sleep 0.5; done
+  sleep 2
   kill -$sig $pid
   wait $pid
   status=$?

@@ -30,9 +30,12 @@ else
 fi
 
 # An interrupted render resumes to the same image as an uninterrupted one.
-"$nusselt" render "${common[@]}" --spp 1000000 -o "$work/int.exr" &
+"$nusselt" render "${common[@]}" --spp 1000000 --checkpoint 1 -o "$work/int.exr" &
 pid=$!
-sleep 3
+# Interrupt once the render loop runs (its first checkpoint exists: setup time varies with the
+# load), after a few more passes.
+for _ in $(seq 600); do [ -s "$work/int.exr" ] && break; sleep 0.5; done
+sleep 1
 kill -INT $pid
 wait $pid
 k=$("$nusselt" info "$work/int.exr" 2>/dev/null | sed -n 's/^  nusselt\/spp: //p')
@@ -67,9 +70,11 @@ fi
 
 # A crash (SIGKILL: no handler runs) loses at most one checkpoint interval: the output holds a
 # resumable image.
-"$nusselt" render "${common[@]}" --spp 1000000 --checkpoint 1 -o "$work/crash.exr" &
+"$nusselt" render "${common[@]}" --spp 1000000 --checkpoint 1 -o "$work/crash.exr" 2>/dev/null &
 pid=$!
-sleep 4
+# Kill once the first checkpoint exists (setup time varies with the load).
+for _ in $(seq 600); do [ -s "$work/crash.exr" ] && break; sleep 0.5; done
+sleep 0.5
 kill -KILL $pid
 wait $pid 2>/dev/null
 k=$("$nusselt" info "$work/crash.exr" 2>/dev/null | sed -n 's/^  nusselt\/spp: //p')
