@@ -30,23 +30,11 @@ namespace {
 using qttest::kRings;
 using qttest::kSectors;
 
-struct SCase {
-  std::string model;
-  bool hard = false;
-  double thetaDeg = 0, phiDeg = 0;
-  std::string name() const {
-    char b[128];
-    std::snprintf(b, sizeof b, "%s/%s/theta=%.1f/phi=%.1f", model.c_str(), hard ? "hard" : "typical", thetaDeg, phiDeg);
-    return b;
-  }
-  vec3 v() const {
-    double t = thetaDeg * M_PI / 180, p = phiDeg * M_PI / 180;
-    return vec3(float(std::sin(t) * std::cos(p)), float(std::sin(t) * std::sin(p)), float(std::cos(t)));
-  }
-  BrdfParams params() const {
-    const ModelSpec* m = findModel(model);
-    return packParams(*m, hard ? hardParams(*m) : typicalParams(*m), name());
-  }
+// The chi-square suite's case (model, set, angles) with the accessors this file uses.
+struct SCase : qttest::Case {
+  SCase(std::string m, bool h, double t, double p = 0) : qttest::Case{std::move(m), h, t, p} {}
+  vec3 v() const { return qttest::knownDirection(*this); }
+  BrdfParams params() const { return qttest::caseParams(*this); }
   std::uint32_t id() const { return findModel(model)->id; }
 };
 
