@@ -12,7 +12,7 @@ tmp=$(mktemp)
   echo
   echo "Produced by \`tools/measure.sh\` on $(date -u +%Y-%m-%d) ($(nproc) cores, $(uname -m))."
   echo "Every block is the verbatim output of the command above it."
-  for cmd in "bench render" "bench pipelines" "bench precompute"; do
+  for cmd in "bench render" "bench pipelines" "bench precompute" "bench precompute --preset hard --audit 16"; do
     echo
     echo "## nusselt $cmd"
     echo

@@ -34,6 +34,8 @@ struct QuadHost {
   // "every leaf accepts at least 1 / n_max of its candidates" reads them.
   std::uint64_t* leafEvaluations = nullptr;
   std::uint64_t* leafAccepted = nullptr;
+  // Optional: called for every evaluation with f > e (global leaf index, the point, f, e).
+  void (*onViolation)(std::uint32_t leaf, vec3 w, float f, float e) = nullptr;
 };
 inline thread_local QuadHost* g_quadHost = nullptr;
 inline void quadCountTrials(std::uint32_t evals, std::uint32_t trials, std::uint32_t depth, std::uint32_t leaf, bool accepted) {
@@ -51,6 +53,8 @@ SHARED_END
 #define QT_NODE(i) (::nusselt::shared::g_quadHost->nodes[i])
 #define QT_LEAF(i) (::nusselt::shared::g_quadHost->leaves[i])
 #define QT_COUNT_BOUND_VIOLATION() (::nusselt::shared::g_quadHost->boundViolations++)
+#define QT_REPORT_VIOLATION(leaf, w, f, e) \
+  if (::nusselt::shared::g_quadHost->onViolation) ::nusselt::shared::g_quadHost->onViolation(leaf, w, f, e)
 #define QT_COUNT_TRIAL_FAILURE() (::nusselt::shared::g_quadHost->trialFailures++)
 #define QT_COUNT_TRIALS(evals, n, depth, leaf, ok) ::nusselt::shared::quadCountTrials(evals, n, depth, leaf, ok)
 #else
@@ -59,6 +63,7 @@ SHARED_END
 #define QT_NODE(i) (g.quadNodes.v[i])
 #define QT_LEAF(i) (g.quadLeaves.v[i])
 #define QT_COUNT_BOUND_VIOLATION() atomicAdd(g.stats.v[STAT_SAMPLER_BOUND_VIOLATIONS], 1u)
+#define QT_REPORT_VIOLATION(leaf, w, f, e)
 #define QT_COUNT_TRIAL_FAILURE() atomicAdd(g.stats.v[STAT_SAMPLER_TRIAL_FAILURES], 1u)
 #define QT_COUNT_TRIALS(evals, n, depth, leaf, ok)
 #endif
@@ -193,13 +198,64 @@ SHARED_FN float quadAlbedo(uint set, float cosTheta, float phi) {
   return mix(mix(a00, a10, ts.x), mix(a01, a11, ts.x), ts.y);
 }
 
+// Child of node N chosen by its masses with the uniform number ux, which is rescaled to the
+// chosen child's share (one uniform number serves the whole descent). t = ux * total falls in
+// [m0 + .. + m(c-1), m0 + .. + mc) in float arithmetic; a child whose interval is empty in floats
+// (a mass below the rounding of its predecessors') is never chosen. When rounding puts t at or
+// beyond the total, the heaviest child is taken: never a negligible one (which an earlier
+// version picked about once per 2^24 descents, with an envelope that was never meant to be used).
+SHARED_FN uint quadPickChild(QuadNode N, INOUT(float) ux, OUT(float) share) {
+  float m0 = N.mass.x, m1 = N.mass.y, m2 = N.mass.z, m3 = N.mass.w;
+  float t = ux * (m0 + m1 + m2 + m3);
+  float e1 = m0, e2 = m0 + m1, e3 = m0 + m1 + m2, e4 = m0 + m1 + m2 + m3;
+  uint c;
+  float below;
+  if (t < e1) { c = 0u; below = 0.0f; }
+  else if (t < e2) { c = 1u; below = e1; }
+  else if (t < e3) { c = 2u; below = e2; }
+  else if (t < e4) { c = 3u; below = e3; }
+  else {
+    c = 0u;
+    if (m1 > N.mass[c]) c = 1u;
+    if (m2 > N.mass[c]) c = 2u;
+    if (m3 > N.mass[c]) c = 3u;
+    below = t - N.mass[c];
+  }
+  ux = clamp((t - below) / N.mass[c], 0.0f, NUSSELT_ONE_MINUS_EPS);
+  share = N.mass[c] / e4;
+  return c;
+}
+
+// Inverse CDF of the density proportional to exp(k (t - 1/2)) on [0, 1]; k = 0 is uniform (the
+// builder sets |k| < QT_MIN_SLOPE to 0, so the formulas below never cancel badly).
+SHARED_FN float quadExpSample(float k, float u) {
+  if (k == 0.0f) return u;
+  float t = k > 0.0f ? 1.0f + portableLog(u + (1.0f - u) * exp(-k)) / k : portableLog((1.0f - u) + u * exp(k)) / k;
+  return clamp(t, 0.0f, 1.0f);
+}
+// (cos, sin) of pi t for t in [-2, 2], reduced so that t = 0, +-1, +-2 give sin = 0 exactly: the
+// seams of the half disc (isotropic sets, mirrored at y = 0) neither overlap nor leave a gap.
+SHARED_FN vec2 quadCosSinPi(float t) {
+  float ss = 1.0f;
+  float sc = 1.0f;
+  float a = t;
+  if (a < 0.0f) { a = -a; ss = -1.0f; }
+  if (a > 1.0f) { a = 2.0f - a; ss = -ss; }
+  if (a > 0.5f) { a = 1.0f - a; sc = -1.0f; }
+  float ph = a * NUSSELT_PI;
+  return vec2(sc * cos(ph), ss * sin(ph));
+}
+// Integral of exp(k (t - 1/2)) over [0, 1].
+SHARED_FN float quadExpMass(float k) { return k == 0.0f ? 1.0f : (exp(0.5f * k) - exp(-0.5f * k)) / k; }
+
 // Draws w for the known direction v (local frame, v.z > 0) with density quadPdf (returned in
 // pdf, per unit solid angle) and returns f = brdfEval(model, p, w, v) (rgb). u: two uniform
 // numbers (component choice and tree descent); rngKey = (pixel, sample, dimension, seed) of the
 // caller: the in-leaf rejection draws from pcg4d(base + (0, 0, 0, trial)) with base =
-// pcg4d(pixel, sample, RNG_REJECTION_STREAM | dimension, seed) (a double hash: see below). Returns false (w = 0, pdf = 0, f = 0) when v is below the surface, the table
-// has no mass, or QT_MAX_TRIALS trials were all rejected (counted as a trial failure).
-// Samples that saw f > M in their leaf are counted as bound violations.
+// pcg4d(pixel, sample, RNG_REJECTION_STREAM | dimension, seed) (a double hash: see below).
+// Returns false (w = 0, pdf = 0, f = 0) when v is below the surface, the table has no mass, or
+// QT_MAX_TRIALS trials were all rejected (counted as a trial failure). Samples that saw f > e in
+// their leaf are counted as bound violations.
 SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, uvec4 rngKey, OUT(vec3) w,
                           OUT(float) pdf, OUT(vec3) f) {
   w = vec3(0.0f);
@@ -207,7 +263,8 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, uv
   f = vec3(0.0f);
   if (v.z <= 0.0f) return false;
   QuadSet S = QT_SET(set);
-  vec4 fr = quadFrame((S.info.w & QT_SET_ANISOTROPIC) != 0u, v);
+  bool aniso = (S.info.w & QT_SET_ANISOTROPIC) != 0u;
+  vec4 fr = quadFrame(aniso, v);
   uvec4 idx;
   vec2 ts;
   bool exact = quadGrid(S, quadToCanonical(fr, v), idx, ts);
@@ -228,30 +285,47 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, uv
     if (uy >= 1.0f - ts.y) j = idx.w;
     QuadTable T = QT_TABLE(S.info.x + k * np + j);
     vec3 vk = quadTableDirection(T);
-    if (T.data.x <= 0.0f) return false;
+    if (T.data.x <= 0.0f || T.info.x == QT_EMPTY) return false;
 
-    // ---- Leaf: descend with one uniform number, rescaled at each level ----
-    float x0 = -1.0f, x1 = 1.0f, y0 = -1.0f, y1 = 1.0f;
+    // ---- Root: inner squares and the polar rim (quadtree_layout.h); isotropic sets store the
+    // half disc y >= 0 and mirror it with probability 1/2 (the first bit of the descent number) ----
     float ux = u.x;
-    uint link = T.info.x;
-    uint depth = 0u;
+    bool mirrored = false;
+    if (!aniso) {
+      mirrored = ux >= 0.5f;
+      ux = mirrored ? 2.0f * ux - 1.0f : 2.0f * ux;
+    }
+    // The rescaled number keeps 24 bits of resolution relative to the path's probability: when
+    // that probability falls below 2^-10 a fresh number from the rejection stream takes over (an
+    // exact choice as well), so that leaves far below 2^-24 of the total get their own odds.
+    uvec4 base = pcg4d(uvec4(rngKey.x, rngKey.y, (rngKey.z & 0xffffu) | RNG_REJECTION_STREAM, rngKey.w));
+    float pathShare = 1.0f;
+    float share;
+    QuadNode R = QT_NODE(T.info.x);
+    uint rc = quadPickChild(R, ux, share);
+    pathShare *= share;
+    float x0 = -1.0f, x1 = 1.0f, y0 = -1.0f, y1 = 1.0f;
+    if (!aniso) {
+      y0 = 0.0f;
+      if (rc == 0u) x1 = 0.0f;
+      else x0 = 0.0f;
+    }
+    uint link = R.child[rc];
+    uint depth = 1u;
+
+    // ---- Leaf: descend with the same number, rescaled at each level ----
     for (uint d = 0u; d < QT_MAX_DESCENT; ++d) {
       if ((link & QT_LEAF_BIT) != 0u) break;
       ++depth;
       QuadNode N = QT_NODE(link);
-      float m0 = N.mass.x, m1 = N.mass.y, m2 = N.mass.z, m3 = N.mass.w;
-      float t = ux * (m0 + m1 + m2 + m3);
-      uint c = 0u;
-      float below = 0.0f;
-      if (t >= m0) { c = 1u; below = m0; }
-      if (t >= m0 + m1) { c = 2u; below = m0 + m1; }
-      if (t >= m0 + m1 + m2) { c = 3u; below = m0 + m1 + m2; }
-      if (N.mass[c] <= 0.0f) {  // rounding at a boundary: the last child with mass
-        c = m3 > 0.0f ? 3u : (m2 > 0.0f ? 2u : (m1 > 0.0f ? 1u : 0u));
-        below = t - 0.5f * N.mass[c];
+      if (pathShare < 1.0f / 1024.0f) {
+        uvec4 hd = pcg4d(uvec4(base.x, base.y, base.z ^ 0x5bd1e995u, base.w + d));
+        ux = float(hd.x >> 8u) * (1.0f / 16777216.0f);
+        pathShare = 1.0f;
       }
-      ux = clamp((t - below) / N.mass[c], 0.0f, NUSSELT_ONE_MINUS_EPS);
-      float xm = 0.5f * (x0 + x1);
+      uint c = quadPickChild(N, ux, share);
+      pathShare *= share;
+      float xm = 0.5f * (x0 + x1);  // square geometry (unused below polar nodes)
       float ym = 0.5f * (y0 + y1);
       if ((c & 1u) != 0u) x0 = xm; else x1 = xm;
       if ((c & 2u) != 0u) y0 = ym; else y1 = ym;
@@ -259,64 +333,87 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, uv
     }
     if ((link & QT_LEAF_BIT) == 0u || link == QT_EMPTY) return false;
     QuadLeaf L = QT_LEAF(link & ~QT_LEAF_BIT);
-    bool rim = L.data.z > 0.5f;
-    float s = L.data.w;
-    // Envelope e = A + B cos^-s >= f over the leaf (B = 0 and e = A inside the disc).
+    uint kind = uint(L.data.z + 0.5f);
     float A = L.data.x;
-    float B = L.box.w;
-
-    // Polar box of (leaf & disc) (rim proposal): cos theta in [0, coA], phi in [pa, pa + dp].
-    // Its density is proportional to e: the uniform part (A, area dp coA^2 / 2) with probability
-    // pU, the cos^-s part (B, measure dp coA^(2-s) / (2-s)) otherwise.
-    float coA = L.box.x;
-    float pa = L.box.y;
-    float dp = L.box.z;
-    float wU = A * coA * coA * 0.5f;
-    float wS = B > 0.0f ? B * pow(coA, 2.0f - s) / (2.0f - s) : 0.0f;
-    float pU = wU / (wU + wS);
+    float s = L.data.w;
+    float k1 = L.env.x;
+    float k2 = L.env.y;
+    float B = L.env.z;
+    bool polar = kind != QT_PROPOSAL_SQUARE;
+    // Polar box: cos theta in [c0, c1], phi / pi in [p0, p1]; the exponential part is uniform in
+    // (c^2, phi) times its slopes, the cos^-s part has disc density ~ c^-s: c^(2-s) uniform.
+    float c0 = L.box.x;
+    float c1 = L.box.y;
+    float p0 = L.box.z;
+    float p1 = L.box.w;
+    float u0 = c0 * c0;
+    float u1 = c1 * c1;
+    float pE = 1.0f;
+    float g0 = 0.0f;
+    float g1 = 0.0f;
+    if (polar && B > 0.0f) {
+      g0 = pow(c0, 2.0f - s);
+      g1 = pow(c1, 2.0f - s);
+      float wE = A * quadExpMass(k1) * quadExpMass(k2) * 0.5f * (u1 - u0);
+      float wB = B * (g1 - g0) / (2.0f - s);
+      pE = wE / (wE + wB);
+    }
 
     // ---- Rejection in the same leaf (restarting at the root would break proportionality) ----
-    // A trial draws a point from the proposal (uniform square, or the polar box with density
-    // proportional to e); points outside (leaf & disc) are discarded before f is evaluated; the
-    // others are accepted with probability f / e.
+    // A trial draws a point from the proposal (density proportional to e); points outside the
+    // leaf's region are discarded before f is evaluated; the others are accepted with
+    // probability f / e.
     bool accepted = false;
     bool violated = false;
     uint trial = 0u;
     uint evaluations = 0u;
     float fl = 0.0f;
-    // Rejection numbers: a second hash of the hashed key. One hash of a key that differs from the
-    // caller's (descent) key in one component only is strongly correlated with it (pcg4d mixes the
-    // first output little: chi-square 18000 on 2047 dof for lambert), the double hash is not.
-    uvec4 base = pcg4d(uvec4(rngKey.x, rngKey.y, (rngKey.z & 0xffffu) | RNG_REJECTION_STREAM, rngKey.w));
+    // Rejection numbers: from `base`, a second hash of the hashed key. One hash of a key that
+    // differs from the caller's (descent) key in one component only is strongly correlated with
+    // it (pcg4d mixes the first output little: chi-square 18000 on 2047 dof for lambert), the
+    // double hash is not. Trials use base.w + trial; the descent's fresh numbers base.z ^ const.
     for (; trial < QT_MAX_TRIALS; ++trial) {
       uvec4 h = pcg4d(uvec4(base.x, base.y, base.z, base.w + trial));
       float a = float(h.x >> 8u) * (1.0f / 16777216.0f);
       float b = float(h.y >> 8u) * (1.0f / 16777216.0f);
       float cc = float(h.z >> 8u) * (1.0f / 16777216.0f);
-      float x, y, co, e;
-      if (rim) {
-        float cm = float(h.w >> 8u) * (1.0f / 16777216.0f);
-        co = cm < pU ? coA * sqrt(a) : coA * pow(a, 1.0f / (2.0f - s));
+      float cm = float(h.w >> 8u) * (1.0f / 16777216.0f);
+      float x, y, co, t1, t2;
+      if (polar) {
+        if (cm < pE) {
+          t1 = quadExpSample(k1, a);
+          t2 = quadExpSample(k2, b);
+          co = sqrt(mix(u0, u1, t1));
+        } else {
+          co = pow(mix(g0, g1, a), 1.0f / (2.0f - s));
+          t1 = clamp((co * co - u0) / (u1 - u0), 0.0f, 1.0f);
+          t2 = b;
+        }
         if (co <= 0.0f) continue;
         float r = cosFromSin(co);
-        float ph = pa + b * dp;
-        x = r * cos(ph);
-        y = r * sin(ph);
-        if (x < x0 || x > x1 || y < y0 || y > y1) continue;
-        e = B > 0.0f ? A + B * pow(co, -s) : A;
+        vec2 cs = quadCosSinPi(mix(p0, p1, t2));
+        x = r * cs.x;
+        y = r * cs.y;
+        if (kind == QT_PROPOSAL_POLAR_CUT && (x < x0 || x > x1 || y < y0 || y > y1)) continue;
       } else {
-        x = mix(x0, x1, a);
-        y = mix(y0, y1, b);
+        t1 = quadExpSample(k1, a);
+        t2 = quadExpSample(k2, b);
+        x = mix(x0, x1, t1);
+        y = mix(y0, y1, t2);
         float r2 = x * x + y * y;
         if (r2 >= 1.0f) continue;
         co = cosFromSin(sqrt(r2));
-        e = A;
       }
       if (co <= 0.0f) continue;
+      float e = A * exp(k1 * (t1 - 0.5f) + k2 * (t2 - 0.5f));
+      if (B > 0.0f) e += B * pow(co, -s);
       wc = vec3(x, y, co);
       fl = quadEvalLum(model, p, wc, vk);
       ++evaluations;
-      if (fl > e) violated = true;
+      if (fl > e) {
+        violated = true;
+        QT_REPORT_VIOLATION(link & ~QT_LEAF_BIT, wc, fl, e);
+      }
       if (cc * e < fl) { accepted = true; break; }
     }
     QT_COUNT_TRIALS(evaluations, trial + 1u, depth, link & ~QT_LEAF_BIT, accepted);
@@ -325,8 +422,10 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, uv
       QT_COUNT_TRIAL_FAILURE();
       return false;
     }
+    if (mirrored) wc.y = -wc.y;
     if (eps == 0.0f && ts.x == 0.0f && ts.y == 0.0f) {
-      // On a table: one component, pdf = f(w, v_k) cos / a_k with the f already evaluated.
+      // On a table: one component, pdf = f(w, v_k) cos / a_k with the f already evaluated
+      // (at the mirror image for a mirrored sample: the same value, f being symmetric).
       w = quadFromCanonical(fr, wc);
       pdf = fl * wc.z / T.data.x;
       f = brdfEval(model, p, w, v);

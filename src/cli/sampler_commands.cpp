@@ -17,6 +17,7 @@
 #include "brdf/registry.h"
 #include "cli/commands.h"
 #include "quadtree/sample_run.h"
+#include "quadtree/quadtree_build.h"
 #include "quadtree/sampler_tables.h"
 #include "sampling/tabulated.h"
 #include "util/error.h"
@@ -76,38 +77,64 @@ const ModelSpec& modelOrThrow(const std::string& name) {
   return *m;
 }
 
-// The tree of table `table` drawn over the disc (leaf squares coloured by f / M), plus samples.
-void writeSvg(const std::string& path, const quadtree::SamplerTables& t, std::uint32_t table,
+// The tree of table `table` drawn over the disc, plus samples: square leaves as squares, polar
+// leaves (the rim annulus) as annular sectors, shaded by their mean density; isotropic sets store
+// the half disc y >= 0, drawn mirrored below it (dashed).
+void writeSvg(const std::string& path, const quadtree::SamplerTables& t, std::uint32_t set, std::uint32_t table,
               const std::vector<vec4>& samples, const std::string& title) {
   std::ofstream out(path);
   if (!out) throw Error("--svg " + path + ": cannot write");
   const double S = 400;  // pixels per unit
   auto px = [&](double x) { return (x + 1.05) * S; };
   auto py = [&](double y) { return (1.05 - y) * S; };
+  const bool aniso = (t.sets[set].info.w & QT_SET_ANISOTROPIC) != 0u;
   out << "<svg xmlns='http://www.w3.org/2000/svg' width='" << 2.1 * S << "' height='" << 2.1 * S + 30 << "'>\n";
   out << "<rect width='100%' height='100%' fill='white'/>\n";
   out << "<circle cx='" << px(0) << "' cy='" << py(0) << "' r='" << S << "' fill='#f4f4f4' stroke='black' stroke-width='1'/>\n";
-  struct Cell { std::uint32_t link; double x0, y0, size; };
-  std::vector<Cell> stack{{t.tables[table].info.x, -1, -1, 2}};
-  double rootMass = t.tables[table].data.x;
-  while (!stack.empty()) {
-    Cell c = stack.back();
-    stack.pop_back();
-    if (c.link == QT_EMPTY) continue;
-    if (c.link & QT_LEAF_BIT) {
-      const QuadLeaf& l = t.leaves[c.link & ~QT_LEAF_BIT];
-      double density = l.data.y / (c.size * c.size) / std::max(rootMass, 1e-30);  // mean pdf on the disc
-      double shade = std::min(1.0, std::log1p(density) / std::log1p(50.0));
-      int r = int(255 * (1 - 0.7 * shade)), gg = int(255 * (1 - 0.5 * shade));
-      out << "<rect x='" << px(c.x0) << "' y='" << py(c.y0 + c.size) << "' width='" << c.size * S << "' height='"
-          << c.size * S << "' fill='rgb(" << r << "," << gg << ",255)' fill-opacity='0.6' stroke='"
-          << (l.data.z > 0.5f ? "#c00000" : "#303030") << "' stroke-width='0.4'/>\n";
-      continue;
+  // Square cells cover the inner disc only: clip them to it.
+  out << "<clipPath id='inner'><circle cx='" << px(0) << "' cy='" << py(0) << "' r='" << S * std::sqrt(double(QT_INNER_R2))
+      << "'/></clipPath>\n";
+  const double rootMass = std::max(double(t.tables[table].data.x), 1e-30);
+  auto fill = [&](double mass, double area) {
+    double density = mass / std::max(area, 1e-30) / rootMass;  // mean pdf on the disc
+    double shade = std::min(1.0, std::log1p(density) / std::log1p(50.0));
+    int r = int(255 * (1 - 0.7 * shade)), gg = int(255 * (1 - 0.5 * shade));
+    return "rgb(" + std::to_string(r) + "," + std::to_string(gg) + ",255)";
+  };
+  auto sector = [&](const QuadLeaf& l, double ySign, bool dashed) {
+    double c0 = l.box.x, c1 = l.box.y, t0 = l.box.z, t1 = l.box.w;
+    double r0 = std::sqrt(std::max(0.0, 1 - c1 * c1)), r1 = std::sqrt(std::max(0.0, 1 - c0 * c0));
+    double area = 0.5 * (c1 * c1 - c0 * c0) * (t1 - t0) * M_PI;
+    std::string d;
+    const int K = 8;
+    auto pt = [&](double r, double tt) {
+      char b[64];
+      std::snprintf(b, sizeof b, "%.2f,%.2f ", px(r * std::cos(M_PI * tt)), py(ySign * r * std::sin(M_PI * tt)));
+      return std::string(b);
+    };
+    for (int k = 0; k <= K; ++k) d += pt(r1, t0 + (t1 - t0) * k / K);
+    for (int k = K; k >= 0; --k) d += pt(r0, t0 + (t1 - t0) * k / K);
+    out << "<polygon points='" << d << "' fill='" << fill(l.data.y, area) << "' fill-opacity='0.6' stroke='#c00000' stroke-width='0.4'"
+        << (dashed ? " stroke-dasharray='2,2'" : "") << "/>\n";
+  };
+  quadtree::forEachLeaf(t.nodes.data(), t.leaves.data(), t.tables[table].info.x, aniso,
+                        [&](std::uint32_t, const QuadLeaf& l, double x0, double y0, double size) {
+    for (int mirror = 0; mirror < (aniso ? 1 : 2); ++mirror) {
+      const std::uint32_t kind = std::uint32_t(l.data.z + 0.5f);
+      if (kind == QT_PROPOSAL_POLAR) {
+        sector(l, mirror ? -1 : 1, mirror != 0);
+        continue;
+      }
+      // Squares (the inner-circle cuts outlined red), clipped to the inner disc.
+      double y = mirror ? -(y0 + size) : y0;
+      out << "<rect x='" << px(x0) << "' y='" << py(y + size) << "' width='" << size * S << "' height='" << size * S
+          << "' fill='" << fill(l.data.y, size * size) << "' fill-opacity='0.6' stroke='"
+          << (kind == QT_PROPOSAL_POLAR_CUT ? "#c00000" : "#303030") << "' stroke-width='0.4'"
+          << (mirror ? " stroke-dasharray='2,2'" : "") << " clip-path='url(#inner)'/>\n";
     }
-    const QuadNode& n = t.nodes[c.link];
-    double h = 0.5 * c.size;
-    for (int k = 0; k < 4; ++k) stack.push_back({n.child[k], c.x0 + ((k & 1) ? h : 0), c.y0 + ((k & 2) ? h : 0), h});
-  }
+  });
+  out << "<circle cx='" << px(0) << "' cy='" << py(0) << "' r='" << S * std::sqrt(double(QT_INNER_R2))
+      << "' fill='none' stroke='#808080' stroke-width='0.6' stroke-dasharray='4,3'/>\n";
   for (const vec4& s : samples)
     if (s.w > 0) out << "<circle cx='" << px(s.x) << "' cy='" << py(s.y) << "' r='0.9' fill='black'/>\n";
   out << "<text x='10' y='" << 2.1 * S + 20 << "' font-family='monospace' font-size='13'>" << title << "</text>\n</svg>\n";
@@ -196,9 +223,9 @@ int sampleCommand(const SampleArgs& a) {
     std::uint32_t k = std::min<std::uint32_t>(std::uint32_t(std::lround(th / s.data.y)), s.info.y - 1);
     std::uint32_t j = s.info.z > 1 ? std::min<std::uint32_t>(std::uint32_t(std::lround(ph / s.data.z)), s.info.z - 1) : 0;
     char title[256];
-    std::snprintf(title, sizeof title, "%s (%s), table theta=%.1f deg: %u samples; red outline: rim-proposal leaves",
+    std::snprintf(title, sizeof title, "%s (%s), table theta=%.1f deg: %u samples; red: polar leaves (rim, inner-circle cuts)",
                   m.name.c_str(), a.preset.empty() ? "typical" : a.preset.c_str(), k * 90.0 / s.info.y, a.n);
-    writeSvg(a.svg, tables, s.info.x + k * s.info.z + j, b.wPdf, title);
+    writeSvg(a.svg, tables, setIndex[0], s.info.x + k * s.info.z + j, b.wPdf, title);
   }
   return kExitOk;
 }
@@ -209,20 +236,26 @@ struct BenchArgs {
   std::uint32_t thetaTables = 90;
   std::uint32_t phiTables = 16;
   unsigned threads = 0;
+  int audit = 0;  // lattice points per axis of the envelope audit (0: none)
 };
 
+// The time to build every model's trees (cache off), their size and shape, beside the paper's
+// start-up times; with --audit N, every leaf's envelope checked against f on an N x N lattice.
 int benchPrecompute(const BenchArgs& a) {
   static const std::map<std::string, double> paper = {
       {"ashikhmin_shirley", 51.4}, {"beard_maxwell", 15.5}, {"blinn", 8.7}, {"coupled", 22.6},
       {"htsg", 102.7}, {"lafortune", 6.6}, {"lewis", 6.9}, {"minnaert", 7.3}, {"oren_nayar", 10.5},
       {"phong", 6.9}, {"poulin_fournier", 35.5}, {"schlick", 13.2}, {"strauss", 10.9},
       {"torrance_sparrow", 8.3}, {"ward", 20.7}};
+  const unsigned threads = a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency());
   std::printf("# nusselt bench precompute: %s parameters, %u theta tables (x%u phi tables when anisotropic), cache off, %u threads\n",
-              a.preset.c_str(), a.thetaTables, a.phiTables, a.threads ? a.threads : std::max(1u, std::thread::hardware_concurrency()));
-  std::printf("%-18s %5s %9s %9s %9s %10s %7s %7s %6s %8s %9s\n", "model", "trees", "wall_s", "nodes", "leaves", "KiB",
-              "capped", "rim", "depth", "minAcc", "paper_s");
-  double sum = 0;
-  int count = 0;
+              a.preset.c_str(), a.thetaTables, a.phiTables, threads);
+  std::printf("%-17s %5s %8s %7s %7s %8s %6s %6s %6s %5s %5s %5s %6s %7s", "model", "trees", "wall_s", "leaves", "B/tree", "KiB",
+              "polar", "exp", "sing", "tail", "cap", "depth", "minAcc", "paper_s");
+  if (a.audit) std::printf(" %9s", "max f/e");
+  std::printf("\n");
+  double sum = 0, worstAudit = 0;
+  int count = 0, under = 0;
   for (const ModelSpec& m : allModels()) {
     if (m.delta) continue;
     if (!a.models.empty() && std::find(a.models.begin(), a.models.end(), m.name) == a.models.end()) continue;
@@ -238,13 +271,38 @@ int benchPrecompute(const BenchArgs& a) {
     auto it = paper.find(m.name);
     char ps[16] = "-";
     if (it != paper.end()) std::snprintf(ps, sizeof ps, "%.1f", it->second);
-    std::printf("%-18s %5u %9.3f %9u %9u %10.1f %7u %7u %6u %8.3f %9s\n", m.name.c_str(), s.trees, t.seconds, s.nodes, s.leaves,
-                s.bytes / 1024.0, s.cappedLeaves, s.rimLeaves, s.maxDepth, s.minAcceptance, ps);
+    std::uint32_t singular = 0;
+    for (const QuadLeaf& l : t.leaves) singular += l.env.z > 0.0f ? 1u : 0u;
+    std::printf("%-17s %5u %8.3f %7u %7.0f %8.1f %6u %6u %6u %5u %5u %5u %6.3f %7s", m.name.c_str(), s.trees, t.seconds, s.leaves,
+                double(s.bytes) / s.trees, s.bytes / 1024.0, s.rimLeaves, s.expLeaves, singular, s.tailLeaves, s.cappedLeaves,
+                s.maxDepth, s.minAcceptance, ps);
+    if (a.audit) {
+      double worst = 0;
+      const QuadSet& S = t.sets[0];
+      for (std::uint32_t k = 0; k < S.info.y * S.info.z; ++k) {
+        const QuadTable& T = t.tables[S.info.x + k];
+        quadtree::EnvelopeAudit au = quadtree::auditEnvelopes(m.id, p, quadTableDirection(T), t.nodes.data(), t.leaves.data(),
+                                                              T.info.x, T.data.x, a.audit);
+        worst = std::max(worst, au.worst);
+      }
+      std::printf(" %9.4f", worst);
+      worstAudit = std::max(worstAudit, worst);
+    }
+    std::printf("\n");
     std::fflush(stdout);
     sum += t.seconds;
+    under += t.seconds < 0.2 ? 1 : 0;
     ++count;
   }
-  if (count) std::printf("mean wall time %.3f s over %d models (paper: 20.71 s stated, 21.85 s from its 15 values)\n", sum / count, count);
+  if (count) {
+    std::printf("mean wall time %.3f s over %d models (paper: 20.71 s stated, 21.85 s from its 15 values); %d of %d under 0.2 s\n",
+                sum / count, count, under, count);
+    if (a.audit) std::printf("largest f / envelope on the %d x %d lattices: %.4f (above 1 would be a bound violation)\n", a.audit,
+                             a.audit, worstAudit);
+  }
+  std::printf("columns: B/tree bytes per tree; polar leaves (rim annulus and inner-circle cuts); exp: leaves with an exponential\n"
+              "envelope; sing: with a cos^-s part; tail: negligible-mass leaves below 1/n_max; cap: leaves at the depth cap below\n"
+              "1/n_max; minAcc: the lowest acceptance I/V of the other leaves (n_max = 2: at least 0.5)\n");
   return kExitOk;
 }
 
@@ -274,12 +332,14 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
   sample->callback([sa, &run]() { run = [sa]() { return sampleCommand(*sa); }; });
 
   auto ba = std::make_shared<BenchArgs>();
-  CLI::App* pre = bench.add_subcommand("precompute", "Time to build the 90 trees of every model (cache disabled)");
+  CLI::App* pre = bench.add_subcommand("precompute", "Time to build the trees of every model (cache disabled), beside the paper's start-up times");
   pre->add_option("--model", ba->models, "Only these models (repeatable)");
   pre->add_option("--preset", ba->preset, "typical (default) or hard")->check(CLI::IsMember({"typical", "hard"}));
   pre->add_option("--theta-tables", ba->thetaTables, "Tables along theta")->capture_default_str()->check(CLI::Range(1u, 4096u));
   pre->add_option("--phi-tables", ba->phiTables, "Tables along phi (anisotropic models)")->capture_default_str()->check(CLI::Range(2u, 1024u));
   pre->add_option("--threads", ba->threads, "Build threads (0: all cores)")->capture_default_str();
+  pre->add_option("--audit", ba->audit, "Also check every leaf's envelope against f on an N x N lattice (0: no)")
+      ->capture_default_str()->check(CLI::Range(0, 512));
   pre->callback([ba, &run]() { run = [ba]() { return benchPrecompute(*ba); }; });
 
   registerBenchError(bench, run);

@@ -1,14 +1,17 @@
-// quadtree_build.cpp: one disc quadtree per known direction (Montes et al. 2008).
+// quadtree_build.cpp: one disc tree per known direction (Montes et al. 2008), docs/sampler.md.
 //
-// Root: the square [-1, 1]^2, f = 0 outside the disc. A node is split into four while
-// n_max I / V < 1 (I = integral of f over the node, V = M x proposal area, M an upper bound of
-// f on the node) or while its integral is not converged (|Q(node) - sum Q(children)| too large).
-// Integrals: tensor Gauss-Legendre on cells inside the disc; on cells cut by the rim, columns
-// split at the rim crossings with end-clustering substitutions (distance to the rim ~ t^4), which
-// make the rim singularities f ~ cos^-s (s <= 1) smooth, with cos computed from the exact distance
-// to the rim (no cancellation). Bounds: the maximum over the node's 4 x 25 Gauss points, a 5 x 5
-// boundary grid, points on the rim arc, and the point of the node nearest to each known peak of
-// the model (mirror direction, normal, rim points, lobe axes, ridge), times a margin.
+// Geometry (shaders/shared/quadtree_layout.h): square cells over the inner disc r^2 < 3/4 and polar
+// cells (c = cos theta, phi) over the rim annulus c < 1/2; isotropic sets store the half disc y >= 0.
+// A cell becomes a leaf when n_max I >= V (I = integral of f over the cell, V = integral of its
+// envelope e >= f), otherwise it is split into four. The envelope is A exp(k1 t1 + k2 t2) (+ B c^-s
+// at the horizon of models unbounded there) in the leaf's proposal coordinates, fitted to every
+// point evaluated in the cell (its Gauss points, its children's, a boundary grid, the rim, and the
+// point of the cell nearest to each known peak of the model), times a margin; the constant
+// envelope of the paper (k = 0, B = 0) is one of the candidates, and the smallest V wins.
+// Integrals: tensor Gauss-Legendre; cells cut by the inner circle are integrated column by column;
+// polar cells at the horizon of models with f ~ c^-s use an end-clustering substitution in c. A
+// leaf's mass is refined adaptively inside the leaf (without creating tree nodes) until it agrees
+// with its sub-cells' sum.
 #include "quadtree/quadtree_build.h"
 
 #include <algorithm>
@@ -16,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <stdexcept>
 
 namespace nusselt::quadtree {
 
@@ -58,6 +62,14 @@ ModelTraits modelTraits(std::uint32_t model, const BrdfParams& p) {
 
 namespace {
 
+constexpr double kRimCos = QT_RIM_COS;           // polar annulus: cos theta < kRimCos
+constexpr double kInnerR2 = QT_INNER_R2;         // inner disc: r^2 < kInnerR2 (= 1 - kRimCos^2)
+const double kInnerR = std::sqrt(kInnerR2);
+constexpr double kTwoPi = 2 * M_PI;
+// A leaf's mass is the sum over sub-cells at least this deep (root children: depth 1).
+constexpr std::uint32_t kMinIntegrationDepth = 3;
+
+
 // Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n).
 struct Gauss {
   std::vector<double> x, w;
@@ -82,72 +94,167 @@ struct Gauss {
     }
   }
 };
-const Gauss& gaussInterior() { static const Gauss g(5); return g; }
-const Gauss& gaussRim() { static const Gauss g(8); return g; }
+const Gauss& gauss5() { static const Gauss g(5); return g; }
+const Gauss& gauss8() { static const Gauss g(8); return g; }
 
-// A point of a 1D rule on [a, b]: position, weight, distances to a and to b (exact, also when
-// tiny: the rim substitutions need them to compute cos without cancellation).
+// One node of a 1D rule on [a, b]: position and weight; `cluster` (-1 none, 0 towards a, 1 towards b)
+// uses the substitution distance ~ u^4 from that end, which makes an end singularity (x^-1/2, a
+// sqrt edge) smooth.
 struct RulePoint {
-  double pos, weight, da, db;
+  double pos, weight, dist;  // dist: distance from the clustered end (exact when tiny)
 };
-
-// Symmetric clustering map on [-1, 1] with P'(t) = 35/32 (1 - t^2)^3: distance to an end ~ (1-t)^4.
-double clusterP(double t) { return (35.0 / 16.0) * (t - t * t * t + 0.6 * std::pow(t, 5) - std::pow(t, 7) / 7.0); }
-double clusterDP(double t) { double s = 1 - t * t; return (35.0 / 32.0) * 2.0 * s * s * s; }
-
-void rule1D(double a, double b, bool clusterA, bool clusterB, const Gauss& g, std::vector<RulePoint>& out) {
+void rule1D(double a, double b, int cluster, const Gauss& g, std::vector<RulePoint>& out) {
   out.clear();
   double L = b - a;
   if (L <= 0) return;
   for (std::size_t i = 0; i < g.x.size(); ++i) {
     double t = g.x[i], w = g.w[i];
     RulePoint p;
-    if (clusterA && clusterB) {
-      double P = clusterP(t);
-      p.da = 0.5 * L * (1 + P);
-      p.db = 0.5 * L * (1 - P);
-      p.weight = w * 0.5 * L * clusterDP(t);
-    } else if (clusterA || clusterB) {
+    if (cluster >= 0) {
       double u = 0.5 * (t + 1);
-      double d = L * u * u * u * u;  // distance from the clustered end
-      double wt = 0.5 * w * 4 * L * u * u * u;
-      if (clusterA) { p.da = d; p.db = L - d; } else { p.db = d; p.da = L - d; }
-      p.weight = wt;
+      p.dist = L * u * u * u * u;
+      p.weight = 0.5 * w * 4 * L * u * u * u;
+      p.pos = cluster == 0 ? a + p.dist : b - p.dist;
     } else {
-      p.da = 0.5 * L * (1 + t);
-      p.db = 0.5 * L * (1 - t);
+      p.pos = a + 0.5 * L * (1 + t);
       p.weight = 0.5 * L * w;
+      p.dist = 0;
     }
-    p.pos = clusterB && !clusterA ? b - p.db : a + p.da;
     out.push_back(p);
   }
 }
 
+// A point where f was evaluated: disc position, cos theta, azimuth (polar cells; NaN: not computed),
+// f, and w: > 0 a quadrature point of the cell's basic rule (its weight), 0 a quadrature point of
+// a finer rule (adaptive refinement), -1 a bound point (boundary grid, peaks, horizon, ridge).
+struct Pt {
+  float x, y, c, phi, f;
+  double w;
+};
+
+struct Cell {
+  bool polar = false;
+  double a0 = 0, a1 = 0, b0 = 0, b1 = 0;  // square: [x0, x1] x [y0, y1]; polar: [c0, c1] x [t0, t1] (phi / pi)
+  std::uint32_t depth = 0;
+  int split = 0;  // polar cells: 0 = 2 x 2, 1 = four slices in c, 2 = four slices in phi (choosePolarSplit)
+  bool cut() const {  // a square cell cut by the inner circle
+    if (polar) return false;
+    double fx = std::max(std::abs(a0), std::abs(a1)), fy = std::max(std::abs(b0), std::abs(b1));
+    return fx * fx + fy * fy > kInnerR2;
+  }
+  // 0 = empty (outside the inner disc)
+  bool outside() const {
+    if (polar) return false;
+    double cx = std::clamp(0.0, a0, a1), cy = std::clamp(0.0, b0, b1);
+    return cx * cx + cy * cy >= kInnerR2;
+  }
+};
+
 struct CellResult {
-  double q = 0;     // integral of f over cell and disc
-  double area = 0;  // area of (cell & disc)
-  double zs = 0;    // integral of cos^-s over (cell & disc): the rim proposal's measure
+  int gridC = 0, gridP = 0;  // polar cells: the first gridC x gridP points are the rule's (c-major)
+  double q = 0;     // integral of f over the cell's region
+  double zs = 0;    // integral of c^-s over the region (polar cells at the horizon)
   double fmax = 0;  // max of f over the points evaluated
   bool anyPositive = false;
-  // (f, cos theta) of every point evaluated, kept for models unbounded at the rim (s > 0): the
-  // envelope A + B cos^-s is fitted to them (Builder::fitEnvelope).
-  std::vector<std::array<float, 2>> pts;
+  std::vector<Pt> pts;  // every point evaluated (quadrature points carry their weight)
+};
+
+// Polar box of (square & inner disc): c in [kRimCos, coA], phi in [pa, pa + dp], padded so that it
+// surely covers the region. Azimuths from the inside corners and the circle crossings of the edges.
+struct PolarBox {  // azimuths in units of pi
+  float c0 = float(kRimCos), c1 = 1, p0 = -1, p1 = 1;
+};
+PolarBox polarBox(double x0, double x1, double y0, double y1) {
+  PolarBox b;
+  double cx = std::clamp(0.0, x0, x1), cy = std::clamp(0.0, y0, y1);
+  double ra2 = cx * cx + cy * cy;
+  bool centreInside = x0 < 0 && 0 < x1 && y0 < 0 && 0 < y1;
+  if (!centreInside) {
+    double mx = 0.5 * (x0 + x1), my = 0.5 * (y0 + y1);
+    double pc = std::atan2(my, mx);
+    double lo = 10, hi = -10;
+    auto add = [&](double px, double py) {
+      double a = std::atan2(mx * py - my * px, mx * px + my * py);
+      lo = std::min(lo, a);
+      hi = std::max(hi, a);
+    };
+    for (int q = 0; q < 4; ++q) {
+      double px = (q & 1) ? x1 : x0, py = (q & 2) ? y1 : y0;
+      double r2 = px * px + py * py;
+      if (r2 < kInnerR2 && r2 > 0) add(px, py);
+    }
+    for (double xe : {x0, x1})
+      if (std::abs(xe) < kInnerR) {
+        double yc = std::sqrt(kInnerR2 - xe * xe);
+        for (double y : {-yc, yc})
+          if (y >= y0 && y <= y1) add(xe, y);
+      }
+    for (double ye : {y0, y1})
+      if (std::abs(ye) < kInnerR) {
+        double xc = std::sqrt(kInnerR2 - ye * ye);
+        for (double x : {-xc, xc})
+          if (x >= x0 && x <= x1) add(x, ye);
+      }
+    // A corner at the disc centre has no azimuth: the edges through it bound the range.
+    if (cx == 0 && cy == 0) {
+      for (double px : {x0, x1})
+        for (double py : {y0, y1})
+          if (px != 0 || py != 0) add(px == 0 ? 0 : px * 1e-3, py == 0 ? 0 : py * 1e-3);
+    }
+    if (hi >= lo) {
+      b.p0 = float((pc + lo - 1e-6) / M_PI);
+      b.p1 = float((pc + hi + 1e-6) / M_PI);
+    }
+  }
+  b.c1 = float(std::min(1.0, std::sqrt(1 - ra2) * (1 + 1e-6) + 1e-7));
+  return b;
+}
+
+// Proposal coordinates of a point in a leaf: square (t over the cell) or polar (c^2 and phi over the box).
+struct Frame {
+  int kind = QT_PROPOSAL_SQUARE;
+  double a0, a1, b0, b1;  // square: x, y bounds; polar: c0, c1, phi0 / pi, phi1 / pi
+  void coords(const Pt& p, double& t1, double& t2) const {
+    if (kind == QT_PROPOSAL_SQUARE) {
+      t1 = (p.x - a0) / (a1 - a0);
+      t2 = (p.y - b0) / (b1 - b0);
+    } else {
+      double c = p.c, u0 = a0 * a0, u1 = a1 * a1;
+      t1 = (c * c - u0) / (u1 - u0);
+      double ph = (std::isnan(p.phi) ? std::atan2(double(p.y), double(p.x)) : double(p.phi)) / M_PI;
+      // into [mid - 1, mid + 1), mid the box's middle (a box spans at most the full circle, 2)
+      double mid = 0.5 * (b0 + b1);
+      while (ph < mid - 1) ph += 2;
+      while (ph >= mid + 1) ph -= 2;
+      t2 = (ph - b0) / (b1 - b0);
+    }
+    t1 = std::clamp(t1, 0.0, 1.0);
+    t2 = std::clamp(t2, 0.0, 1.0);
+  }
+};
+
+double expMass(double k) { return k == 0 ? 1.0 : 2.0 * std::sinh(0.5 * k) / k; }
+
+struct Envelope {
+  double A = 0, k1 = 0, k2 = 0, B = 0;
+  double V = 0;       // integral of the envelope over the leaf's region (cost: evaluations of f)
+  double trialV = 0;  // ... over its proposal domain (cost: trials, incl. discarded points)
 };
 
 class Builder {
  public:
-  Builder(std::uint32_t model, const BrdfParams& params, vec3 v, const BuildSettings& s)
-      : m_model(model), m_params(params), m_v(v), m_s(s) {
+  Builder(std::uint32_t model, const BrdfParams& params, vec3 v, bool halfDisc, const BuildSettings& s)
+      : m_model(model), m_params(params), m_v(v), m_half(halfDisc), m_s(s) {
     m_traits = modelTraits(model, params);
     collectPeaks();
   }
-
   Tree build();
 
  private:
   std::uint32_t m_model;
   BrdfParams m_params;
   vec3 m_v;
+  bool m_half;
   BuildSettings m_s;
   ModelTraits m_traits;
   std::vector<std::array<double, 2>> m_peaks;  // disc points
@@ -155,35 +262,59 @@ class Builder {
   double m_ridgeX = 0;
   std::uint64_t m_evals = 0;
   std::vector<RulePoint> m_rx, m_ry;
+  double m_aEst = 0;
 
-  // f at the disc point (x, y) with cos theta = co (co computed by the caller, accurately).
-  double eval(double x, double y, double co, CellResult& r) {
+  double eval(double x, double y, double c, double phi, double w, CellResult& r) {
     ++m_evals;
-    double f = quadEvalLum(m_model, m_params, vec3(float(x), float(y), float(co)), m_v);
+    double f = quadEvalLum(m_model, m_params, vec3(float(x), float(y), float(c)), m_v);
     if (f > r.fmax) r.fmax = f;
-    if (m_traits.rimExponent > 0) r.pts.push_back({float(f), float(co)});
     if (f > 0) r.anyPositive = true;
+    r.pts.push_back({float(x), float(y), float(c), float(phi), float(f), w});
     return f;
   }
-  void evalPoint(double x, double y, CellResult& r) {
+  void evalDisc(double x, double y, CellResult& r) {  // bound point given in the disc
     double r2 = x * x + y * y;
     if (r2 >= 1) return;
     double rr = std::sqrt(r2);
-    eval(x, y, std::sqrt((1 - rr) * (1 + rr)), r);
+    eval(x, y, std::sqrt((1 - rr) * (1 + rr)), NAN, -1, r);
+  }
+  void evalPolar(double c, double phi, CellResult& r) {  // bound point given in polar coordinates
+    double rr = std::sqrt((1 - c) * (1 + c));
+    eval(rr * std::cos(phi), rr * std::sin(phi), c, phi, -1, r);
+  }
+  // Whether the quadrature points of r see what its bound points see: no bound point more than 4x
+  // above every quadrature point (f times c^s for models unbounded at the horizon, whose
+  // horizon points are large by nature). A narrow lobe or streak that only a peak or edge point
+  // hits would otherwise be missed by the integral, however well the rules agree.
+  bool resolved(const CellResult& r) const {
+    const double s = m_traits.rimExponent;
+    double qmax = 0, bmax = 0;
+    for (const Pt& p : r.pts) {
+      double v = s > 0 ? p.f * std::pow(std::max(double(p.c), 1e-30), s) : p.f;
+      if (p.w < 0) bmax = std::max(bmax, v);
+      else qmax = std::max(qmax, v);
+    }
+    return bmax <= 4 * qmax;
   }
 
   void collectPeaks();
-  void fitEnvelope(const CellResult& r, double area, double zs, double& A, double& B);
-  std::vector<std::array<double, 2>> m_fit;
-  CellResult integrate(double x0, double x1, double y0, double y1);
-  void boundPoints(double x0, double x1, double y0, double y1, CellResult& r);
+  CellResult integrate(const Cell& c);
+  CellResult integrateSquare(double x0, double x1, double y0, double y1);
+  CellResult integratePolar(double c0, double c1, double p0, double p1);
+  void boundPoints(const Cell& c, CellResult& r);
+  std::array<Cell, 4> children(const Cell& c) const;
+  double refine(const Cell& c, const CellResult& r, CellResult& all, int budget);
+  Frame frameOf(const Cell& c, PolarBox* box) const;
+  Envelope fit(const Cell& c, const Frame& fr, const CellResult& all, const std::vector<Pt>& quad);
+  void polish(const Cell& c, const Frame& fr, CellResult& all, Envelope& env);
+  double tolerance(double q) const { return std::max(m_s.relTol * std::abs(q), m_s.absTol * m_aEst); }
 };
 
 void Builder::collectPeaks() {
   double vx = m_v.x, vy = m_v.y;
   double vr = std::sqrt(vx * vx + vy * vy);
-  m_peaks.push_back({0.0, 0.0});   // normal
-  m_peaks.push_back({-vx, -vy});   // mirror direction R(v)
+  m_peaks.push_back({0.0, 0.0});  // normal
+  m_peaks.push_back({-vx, -vy});  // mirror direction R(v)
   if (vr > 1e-9) {
     m_peaks.push_back({-vx / vr, -vy / vr});  // rim, forward
     m_peaks.push_back({vx / vr, vy / vr});    // rim, back-scatter
@@ -210,313 +341,653 @@ void Builder::collectPeaks() {
   }
 }
 
-// Integral of f over [x0,x1] x [y0,y1] intersected with the disc.
-CellResult Builder::integrate(double x0, double x1, double y0, double y1) {
+CellResult Builder::integrate(const Cell& c) {
+  if (c.polar) return integratePolar(c.a0, c.a1, c.b0 * M_PI, c.b1 * M_PI);
+  return integrateSquare(c.a0, c.a1, c.b0, c.b1);
+}
+
+// Integral of f over [x0,x1] x [y0,y1] intersected with the inner disc.
+CellResult Builder::integrateSquare(double x0, double x1, double y0, double y1) {
   CellResult r;
   double cx = std::clamp(0.0, x0, x1), cy = std::clamp(0.0, y0, y1);
-  double rmin2 = cx * cx + cy * cy;
-  if (rmin2 >= 1) return r;
+  if (cx * cx + cy * cy >= kInnerR2) return r;
   double fx = std::max(std::abs(x0), std::abs(x1)), fy = std::max(std::abs(y0), std::abs(y1));
-  double rmax2 = fx * fx + fy * fy;
-  if (rmax2 <= 1) {
-    const Gauss& g = gaussInterior();
+  const Gauss& g = gauss5();
+  if (fx * fx + fy * fy <= kInnerR2) {
     double hx = 0.5 * (x1 - x0), hy = 0.5 * (y1 - y0);
     for (std::size_t i = 0; i < g.x.size(); ++i)
       for (std::size_t j = 0; j < g.x.size(); ++j) {
         double x = x0 + hx * (1 + g.x[i]), y = y0 + hy * (1 + g.x[j]);
-        double rr = std::sqrt(x * x + y * y);
-        double co = std::sqrt((1 - rr) * (1 + rr));
         double w = g.w[i] * g.w[j] * hx * hy;
-        r.q += w * eval(x, y, co, r);
-        if (m_traits.rimExponent > 0) r.zs += w * std::pow(co, -double(m_traits.rimExponent));
+        r.q += w * eval(x, y, std::sqrt(1 - x * x - y * y), NAN, w, r);
       }
-    r.area = (x1 - x0) * (y1 - y0);
-    if (m_traits.rimExponent == 0) r.zs = r.area;
     return r;
   }
-  // Cut by the rim: split x at the rim crossings of the horizontal edges.
+  // Cut by the inner circle: columns split at the circle crossings of the horizontal edges; the
+  // column height sqrt(R^2 - x^2) has a square-root end at x = +-R, where the rule clusters.
   double bps[6];
   int nb = 0;
-  bps[nb++] = std::max(x0, -1.0);
-  bps[nb++] = std::min(x1, 1.0);
+  bps[nb++] = std::max(x0, -kInnerR);
+  bps[nb++] = std::min(x1, kInnerR);
   for (double ye : {y0, y1}) {
-    if (std::abs(ye) >= 1) continue;
-    double xc = std::sqrt((1 - ye) * (1 + ye));
+    if (std::abs(ye) >= kInnerR) continue;
+    double xc = std::sqrt(kInnerR2 - ye * ye);
     for (double s : {-xc, xc})
       if (s > x0 && s < x1) bps[nb++] = s;
   }
-  for (int i = 1; i < nb; ++i)  // insertion sort (at most 6 values)
+  for (int i = 1; i < nb; ++i)
     for (int j = i; j > 0 && bps[j] < bps[j - 1]; --j) std::swap(bps[j], bps[j - 1]);
-  const Gauss& g = gaussRim();
   for (int k = 0; k + 1 < nb; ++k) {
     double xa = bps[k], xb = bps[k + 1];
     if (xb - xa <= 0) continue;
     double xm = 0.5 * (xa + xb);
-    if (std::abs(xm) >= 1) continue;
-    double hm = std::sqrt((1 - xm) * (1 + xm));
-    if (-hm >= y1 || hm <= y0) continue;  // columns outside the disc
-    bool loRim = -hm > y0, hiRim = hm < y1;
-    bool anyRim = loRim || hiRim;
-    bool clA = anyRim && (xa != x0 || std::abs(xa) == 1.0);
-    bool clB = anyRim && (xb != x1 || std::abs(xb) == 1.0);
-    rule1D(xa, xb, clA, clB, g, m_rx);
+    if (std::abs(xm) >= kInnerR) continue;
+    double hm = std::sqrt(kInnerR2 - xm * xm);
+    if (-hm >= y1 || hm <= y0) continue;  // column outside the circle
+    bool loCirc = -hm > y0, hiCirc = hm < y1;
+    int cl = -1;
+    if ((loCirc || hiCirc) && xa == -kInnerR) cl = 0;
+    else if ((loCirc || hiCirc) && xb == kInnerR) cl = 1;
+    rule1D(xa, xb, cl, (loCirc || hiCirc) ? gauss8() : g, m_rx);
     for (const RulePoint& px : m_rx) {
       double x = px.pos;
-      // 1 - x^2 from the exact distance to x = +-1 when that end is clustered.
-      double h2;
-      if (clA && xa == -1.0) h2 = px.da * (2 - px.da);
-      else if (clB && xb == 1.0) h2 = px.db * (2 - px.db);
-      else h2 = (1 - x) * (1 + x);
+      double h2 = cl == 0 ? px.dist * (2 * kInnerR - px.dist) : cl == 1 ? px.dist * (2 * kInnerR - px.dist) : kInnerR2 - x * x;
       if (h2 <= 0) continue;
       double h = std::sqrt(h2);
-      double lo = loRim ? -h : y0, hi = hiRim ? h : y1;
+      double lo = loCirc ? std::max(-h, y0) : y0, hi = hiCirc ? std::min(h, y1) : y1;
       if (hi <= lo) continue;
-      rule1D(lo, hi, loRim, hiRim, g, m_ry);
+      rule1D(lo, hi, -1, g, m_ry);
       for (const RulePoint& py : m_ry) {
         double y = py.pos;
-        double dHi = hiRim ? py.db : h - y;
-        double dLo = loRim ? py.da : y + h;
-        double co2 = dHi * dLo;
-        if (co2 <= 0) continue;
-        double co = std::sqrt(co2), w = px.weight * py.weight;
-        r.q += w * eval(x, y, co, r);
-        r.area += w;
-        r.zs += w * std::pow(co, -double(m_traits.rimExponent));
+        double w = px.weight * py.weight;
+        double c2 = 1 - x * x - y * y;
+        if (c2 <= 0) continue;
+        r.q += w * eval(x, y, std::sqrt(c2), NAN, w, r);
       }
     }
   }
   return r;
 }
 
-// Extra points for the bound: a 5 x 5 grid on the cell (edges and corners), the rim arc, the
-// point of the cell nearest to each peak, and the ridge line.
-void Builder::boundPoints(double x0, double x1, double y0, double y1, CellResult& r) {
-  // poulin_fournier's cylinder ridge is a fold that the Gauss points straddle: a 5 x 5 grid let
-  // 42 of 200k samples exceed M (test case theta 37.3, phi 20), 17 x 17 none.
-  const int G = m_ridge ? 16 : 4;
-  for (int i = 0; i <= G; ++i)
-    for (int j = 0; j <= G; ++j) evalPoint(x0 + (x1 - x0) * i / G, y0 + (y1 - y0) * j / G, r);
-  for (const auto& pk : m_peaks) {
-    double px = std::clamp(pk[0], x0, x1), py = std::clamp(pk[1], y0, y1);
-    double r2 = px * px + py * py;
-    if (r2 >= 1) {  // nearest point inside the disc: pull onto the rim, slightly inside
-      double s = (1 - 1e-7) / std::sqrt(r2);
-      px *= s;
-      py *= s;
-      if (px < x0 || px > x1 || py < y0 || py > y1) continue;
+// Integral of f over the polar cell [c0, c1] x [p0, p1] (disc measure c dc dphi). At the horizon
+// (c0 = 0) of a model with f ~ c^-s the c rule clusters towards 0.
+CellResult Builder::integratePolar(double c0, double c1, double p0, double p1) {
+  CellResult r;
+  const double s = m_traits.rimExponent;
+  bool cluster = c0 == 0 && s > 0;
+  rule1D(c0, c1, cluster ? 0 : -1, cluster ? gauss8() : gauss5(), m_rx);
+  rule1D(p0, p1, -1, gauss5(), m_ry);
+  r.gridC = int(m_rx.size());
+  r.gridP = int(m_ry.size());
+  for (const RulePoint& pc : m_rx) {
+    double c = std::max(cluster ? pc.dist : pc.pos, 1e-300);
+    double zc = s > 0 ? std::pow(c, -s) : 1.0;
+    for (const RulePoint& pp : m_ry) {
+      double w = pc.weight * pp.weight * c;
+      double f = 0;
+      double rr = std::sqrt((1 - c) * (1 + c));
+      f = eval(rr * std::cos(pp.pos), rr * std::sin(pp.pos), c, pp.pos, w, r);
+      r.q += w * f;
+      r.zs += w * zc;
     }
-    evalPoint(px, py, r);
   }
-  if (m_ridge && m_ridgeX >= x0 && m_ridgeX <= x1)
-    for (int j = 0; j <= 8; ++j) evalPoint(m_ridgeX, y0 + (y1 - y0) * j / 8, r);
-  // Rim arc inside the cell: cos theta = 1e-3 and 1e-6.
-  double fx = std::max(std::abs(x0), std::abs(x1)), fy = std::max(std::abs(y0), std::abs(y1));
-  double cx = std::clamp(0.0, x0, x1), cy = std::clamp(0.0, y0, y1);
-  if (fx * fx + fy * fy > 1 && cx * cx + cy * cy < 1) {
-    for (int k = 0; k < 64; ++k) {
-      double ph = 2 * M_PI * (k + 0.5) / 64;
-      for (double co : {1e-3, 1e-6}) {
-        double rr = std::sqrt((1 - co) * (1 + co));
-        double x = rr * std::cos(ph), y = rr * std::sin(ph);
-        if (x >= x0 && x <= x1 && y >= y0 && y <= y1) eval(x, y, co, r);
-      }
-    }
-    // and the arc's end points on the cell edges
-    for (double ye : {y0, y1})
-      if (std::abs(ye) < 1) {
-        double xc = std::sqrt((1 - ye) * (1 + ye));
-        for (double s : {-xc, xc})
-          if (s >= x0 && s <= x1) evalPoint(s * (1 - 1e-7), ye * (1 - 1e-7), r);
-      }
-    for (double xe : {x0, x1})
-      if (std::abs(xe) < 1) {
-        double yc = std::sqrt((1 - xe) * (1 + xe));
-        for (double s : {-yc, yc})
-          if (s >= y0 && s <= y1) evalPoint(xe * (1 - 1e-7), s * (1 - 1e-7), r);
-      }
-  }
+  return r;
 }
 
-// The envelope e = A + B cos^-s of a cell cut by the rim (s > 0: f ~ cos^-s at the horizon) with
-// the smallest volume V = A area + B zs subject to e >= margin f at every point evaluated in the
-// cell (its quadrature points, its children's, the bound points incl. the rim arc at cos 1e-6).
-// B = 0 where f stays bounded up to the rim (a pure cos^-s proposal would then accept only ~1/2:
-// f cos^s vanishes linearly at the rim), A = 0 where f is purely singular; mixtures in between.
-// V(B) = area h(B) + zs B with h(B) = max_i (F_i - B c_i)^+ is convex: golden-section search.
-void Builder::fitEnvelope(const CellResult& r, double area, double zs, double& A, double& B) {
-  const double s = m_traits.rimExponent, margin = m_s.boundMargin;
-  std::vector<std::array<double, 2>>& fc = m_fit;  // (F_i, c_i = cos_i^-s)
-  fc.clear();
-  double bMax = 0;
-  for (const auto& p : r.pts)
-    if (p[1] > 0 && p[0] > 0) {
-      double c = std::pow(double(p[1]), -s);
-      fc.push_back({margin * double(p[0]), c});
-      bMax = std::max(bMax, fc.back()[0] / c);
-    }
-  auto hOf = [&](double b) {
-    double m = 0;
-    for (const auto& p : fc) m = std::max(m, p[0] - b * p[1]);
-    return m;
-  };
-  auto vOf = [&](double b) { return area * hOf(b) + zs * b; };
-  double lo = 0, hi = bMax;
-  const double gr = 0.5 * (std::sqrt(5.0) - 1);
-  double b1 = hi - gr * (hi - lo), b2 = lo + gr * (hi - lo);
-  double v1 = vOf(b1), v2 = vOf(b2);
-  for (int it = 0; it < 48 && hi - lo > 1e-9 * bMax; ++it) {
-    if (v1 <= v2) { hi = b2; b2 = b1; v2 = v1; b1 = hi - gr * (hi - lo); v1 = vOf(b1); }
-    else { lo = b1; b1 = b2; v1 = v2; b2 = lo + gr * (hi - lo); v2 = vOf(b2); }
-  }
-  double best = v1 <= v2 ? b1 : b2, vBest = std::min(v1, v2);
-  for (double b : {0.0, bMax})
-    if (vOf(b) < vBest) { vBest = vOf(b); best = b; }
-  B = best;
-  A = hOf(best);
-  // The fmax of points without a stored cos (none today) still bounds f: keep A >= 0, B >= 0.
-  A = std::max(A, 0.0);
-}
-
-// Polar box of (cell & disc): r in [r_a, 1] (cos theta in [0, coA]), phi in [pa, pa + dp], padded
-// so that it surely covers the region; z = integral of cos^-s over the box (disc measure), the
-// proposal's area measure. Angles from the inside corners and the rim crossings of the edges.
-struct PolarBox {
-  float coA = 1, pa = 0, dp = float(2 * M_PI);
-};
-PolarBox polarBox(double x0, double x1, double y0, double y1) {
-  PolarBox b;
-  double cx = std::clamp(0.0, x0, x1), cy = std::clamp(0.0, y0, y1);
-  double ra = std::sqrt(cx * cx + cy * cy);
-  // Azimuth range about the cell's centre direction; only a cell with the disc centre strictly
-  // inside (the root) needs the full circle. A corner at the centre (the root's children) has
-  // no azimuth and is skipped: its range comes from the edges' rim crossings.
-  bool centreInside = x0 < 0 && 0 < x1 && y0 < 0 && 0 < y1;
-  if (!centreInside) {
-    double mx = 0.5 * (x0 + x1), my = 0.5 * (y0 + y1);
-    double pc = std::atan2(my, mx);
-    double lo = 10, hi = -10;
-    auto add = [&](double px, double py) {
-      double a = std::atan2(mx * py - my * px, mx * px + my * py);
-      lo = std::min(lo, a);
-      hi = std::max(hi, a);
-    };
-    for (int q = 0; q < 4; ++q) {
-      double px = (q & 1) ? x1 : x0, py = (q & 2) ? y1 : y0;
+// Extra points for the envelope: a boundary grid, the point of the cell nearest to each peak, the
+// ridge line, and the cell's part of the horizon (polar) or of the inner circle (cut squares).
+void Builder::boundPoints(const Cell& cell, CellResult& r) {
+  // poulin_fournier's cylinder ridge (a fold of f along w.x = -v.x) gets its own dense line of
+  // points (below) instead of a denser grid everywhere.
+  const int G = 4;
+  if (!cell.polar) {
+    double x0 = cell.a0, x1 = cell.a1, y0 = cell.b0, y1 = cell.b1;
+    auto inside = [&](double x, double y) { return x * x + y * y < kInnerR2; };
+    for (int i = 0; i <= G; ++i)
+      for (int j = 0; j <= G; ++j) {
+        double x = x0 + (x1 - x0) * i / G, y = y0 + (y1 - y0) * j / G;
+        if (inside(x, y)) evalDisc(x, y, r);
+      }
+    for (const auto& pk : m_peaks) {
+      double px = std::clamp(pk[0], x0, x1), py = std::clamp(pk[1], y0, y1);
       double r2 = px * px + py * py;
-      if (r2 < 1 && r2 > 0) add(px, py);
+      if (r2 >= kInnerR2) {  // nearest point of the inner disc: onto the circle, slightly inside
+        double sc = kInnerR * (1 - 1e-7) / std::sqrt(r2);
+        px *= sc;
+        py *= sc;
+        if (px < x0 || px > x1 || py < y0 || py > y1) continue;
+      }
+      evalDisc(px, py, r);
+      // A peak inside the cell: also a ring of points close around it, where a function whose
+      // limit at the peak depends on the direction of approach (schlick's anisotropy factor at
+      // the mirror direction) takes its supremum.
+      if (std::abs(px - pk[0]) + std::abs(py - pk[1]) < 1e-6)
+        for (double rho : {1e-4, 1e-2})
+          for (int k = 0; k < 8; ++k) {
+            double qx = px + rho * (x1 - x0) * std::cos(k * M_PI / 4), qy = py + rho * (y1 - y0) * std::sin(k * M_PI / 4);
+            if (qx >= x0 && qx <= x1 && qy >= y0 && qy <= y1 && qx * qx + qy * qy < kInnerR2) evalDisc(qx, qy, r);
+          }
     }
-    for (double xe : {x0, x1})
-      if (std::abs(xe) < 1) {
-        double yc = std::sqrt((1 - xe) * (1 + xe));
-        for (double y : {-yc, yc})
-          if (y >= y0 && y <= y1) add(xe, y);
+    if (m_ridge && m_ridgeX >= x0 && m_ridgeX <= x1)
+      for (int j = 0; j <= 32; ++j) {
+        double y = y0 + (y1 - y0) * j / 32;
+        if (inside(m_ridgeX, y)) evalDisc(m_ridgeX, y, r);
       }
-    for (double ye : {y0, y1})
-      if (std::abs(ye) < 1) {
-        double xc = std::sqrt((1 - ye) * (1 + ye));
-        for (double x : {-xc, xc})
-          if (x >= x0 && x <= x1) add(x, ye);
+    if (cell.cut()) {  // the inner circle inside the cell, and its end points on the edges
+      PolarBox b = polarBox(x0, x1, y0, y1);
+      for (int k = 0; k <= 32; ++k) {
+        double ph = M_PI * (b.p0 + (double(b.p1) - b.p0) * k / 32);
+        double x = kInnerR * (1 - 1e-7) * std::cos(ph), y = kInnerR * (1 - 1e-7) * std::sin(ph);
+        if (x >= x0 && x <= x1 && y >= y0 && y <= y1) evalDisc(x, y, r);
       }
-    if (hi >= lo) {
-      b.pa = float(pc + lo - 1e-6);
-      b.dp = float(hi - lo + 2e-6);
+    }
+    return;
+  }
+  double c0 = cell.a0, c1 = cell.a1, p0 = cell.b0 * M_PI, p1 = cell.b1 * M_PI;
+  double cLo = std::max(c0, 1e-6);
+  for (int i = 0; i <= G; ++i)
+    for (int j = 0; j <= G; ++j) evalPolar(cLo + (c1 - cLo) * i / G, p0 + (p1 - p0) * j / G, r);
+  if (c0 == 0)  // the horizon: cos theta = 1e-3 and 1e-6
+    for (int k = 0; k <= 32; ++k)
+      for (double c : {1e-3, 1e-6})
+        if (c <= c1) evalPolar(c, p0 + (p1 - p0) * k / 32, r);
+  for (const auto& pk : m_peaks) {
+    double r2 = pk[0] * pk[0] + pk[1] * pk[1];
+    double c = std::sqrt(std::max(0.0, 1 - r2));
+    double ph = std::atan2(pk[1], pk[0]);
+    double mid = 0.5 * (p0 + p1);
+    while (ph < mid - M_PI) ph += kTwoPi;
+    while (ph >= mid + M_PI) ph -= kTwoPi;
+    double pc = std::clamp(c, cLo, c1), pp = std::clamp(ph, p0, p1);
+    evalPolar(pc, pp, r);
+    if (std::abs(pc - c) + std::abs(pp - ph) < 1e-6)  // at or inside the cell: a ring around it (as for squares)
+      for (double rho : {1e-4, 1e-2})
+        for (int k = 0; k < 8; ++k) {
+          double qc = pc + rho * (c1 - c0) * std::cos(k * M_PI / 4), qp = pp + rho * (p1 - p0) * std::sin(k * M_PI / 4);
+          if (qc >= cLo && qc <= c1 && qp >= p0 && qp <= p1) evalPolar(qc, qp, r);
+        }
+  }
+  if (m_ridge)
+    for (int i = 0; i <= 32; ++i) {
+      double c = cLo + (c1 - cLo) * i / 32, rr = std::sqrt((1 - c) * (1 + c));
+      if (std::abs(m_ridgeX) >= rr) continue;
+      double a = std::acos(m_ridgeX / rr);
+      for (double ph : {a, -a, a - kTwoPi, kTwoPi - a})
+        if (ph >= p0 && ph <= p1) evalPolar(c, ph, r);
+    }
+}
+
+std::array<Cell, 4> Builder::children(const Cell& c) const {
+  std::array<Cell, 4> ch;
+  for (int k = 0; k < 4; ++k) {
+    ch[k] = c;
+    ch[k].depth = c.depth + 1;
+  }
+  if (!c.polar) {
+    double xm = 0.5 * (c.a0 + c.a1), ym = 0.5 * (c.b0 + c.b1);
+    for (int k = 0; k < 4; ++k) {
+      if (k & 1) ch[k].a0 = xm; else ch[k].a1 = xm;
+      if (k & 2) ch[k].b0 = ym; else ch[k].b1 = ym;
+    }
+    return ch;
+  }
+  if (c.split == 2) {  // four azimuth slices
+    double q = 0.25 * (c.b1 - c.b0);
+    for (int k = 0; k < 4; ++k) {
+      ch[k].b0 = c.b0 + k * q;
+      ch[k].b1 = k == 3 ? c.b1 : c.b0 + (k + 1) * q;
+    }
+    return ch;
+  }
+  if (c.split == 1) {  // four slices in c
+    double q = 0.25 * (c.a1 - c.a0);
+    for (int k = 0; k < 4; ++k) {
+      ch[k].a0 = c.a0 + k * q;
+      ch[k].a1 = k == 3 ? c.a1 : c.a0 + (k + 1) * q;
+    }
+    return ch;
+  }
+  double cm = 0.5 * (c.a0 + c.a1), tm = 0.5 * (c.b0 + c.b1);
+  for (int k = 0; k < 4; ++k) {
+    if (k & 1) ch[k].a0 = cm; else ch[k].a1 = cm;
+    if (k & 2) ch[k].b0 = tm; else ch[k].b1 = tm;
+  }
+  return ch;
+}
+
+// How a polar cell splits (the descent needs no polar geometry, so the builder may choose): along
+// the axis where log f varies most over the cell's own Gauss grid (four slices), else 2 x 2; the
+// aspect (azimuth width over c height, both angles at the horizon) stays within [1/16, 16] and
+// far from 1 only where f asks for it. Models whose horizon structure does not depend on the
+// azimuth (schlick's multiple-reflection term) then refine in c alone.
+int choosePolarSplit(const Cell& c, const CellResult& r) {
+  double aspect = (c.b1 - c.b0) * M_PI / (c.a1 - c.a0);
+  double varC = 0, varP = 0;
+  int nC = r.gridC, nP = r.gridP;
+  if (nC >= 2 && nP >= 2 && int(r.pts.size()) >= nC * nP && r.fmax > 0) {
+    double floor = 1e-9 * r.fmax;
+    auto L = [&](int i, int j) { return std::log(std::max(double(r.pts[std::size_t(i * nP + j)].f), floor)); };
+    for (int i = 0; i < nC; ++i)
+      for (int j = 0; j + 1 < nP; ++j) varP += std::abs(L(i, j + 1) - L(i, j));
+    for (int j = 0; j < nP; ++j)
+      for (int i = 0; i + 1 < nC; ++i) varC += std::abs(L(i + 1, j) - L(i, j));
+    varC /= nP * (nC - 1);
+    varP /= nC * (nP - 1);
+  }
+  if (varC > 3 * varP && aspect <= 16) return 1;
+  if (varP > 3 * varC && aspect >= 1.0 / 16) return 2;
+  if (aspect > 2.5) return 2;
+  if (aspect < 0.4) return 1;
+  return 0;
+}
+
+// Adaptive refinement of the integral of a cell whose basic rule gave r.q: the sum over its four
+// sub-cells, recursively where they disagree (integration only: no tree nodes). Points go to all.
+double Builder::refine(const Cell& cell, const CellResult& r, CellResult& all, int budget) {
+  Cell c = cell;
+  c.split = 0;  // integration only: halve both axes (a cell whose grid looks flat along one axis may hide a streak)
+  std::array<Cell, 4> ch = children(c);
+  double sum = 0;
+  CellResult sub[4];
+  for (int k = 0; k < 4; ++k) {
+    if (ch[k].outside()) continue;
+    sub[k] = integrate(ch[k]);
+    sum += sub[k].q;
+  }
+  // Agreement of two rules is trusted only from kMinIntegrationDepth on: on large cells two coarse
+  // rules can agree on a lobe that neither resolves.
+  bool ok = (std::abs(r.q - sum) <= tolerance(sum) && c.depth + 1 >= kMinIntegrationDepth) || budget <= 0;
+  double total = 0;
+  for (int k = 0; k < 4; ++k) {
+    all.fmax = std::max(all.fmax, sub[k].fmax);
+    all.anyPositive = all.anyPositive || sub[k].anyPositive;
+    for (const Pt& p : sub[k].pts) all.pts.push_back({p.x, p.y, p.c, p.phi, p.f, 0.0});
+    if (!ok && sub[k].anyPositive) total += refine(ch[k], sub[k], all, budget - 1);
+    else total += sub[k].q;
+  }
+  return ok ? sum : total;
+}
+
+Frame Builder::frameOf(const Cell& c, PolarBox* box) const {
+  Frame fr;
+  if (c.polar) {
+    fr.kind = QT_PROPOSAL_POLAR;
+    fr.a0 = c.a0;
+    fr.a1 = c.a1;
+    fr.b0 = c.b0;
+    fr.b1 = c.b1;
+  } else if (c.cut()) {
+    PolarBox b = polarBox(c.a0, c.a1, c.b0, c.b1);
+    if (box) *box = b;
+    fr.kind = QT_PROPOSAL_POLAR_CUT;
+    fr.a0 = b.c0;
+    fr.a1 = b.c1;
+    fr.b0 = b.p0;
+    fr.b1 = b.p1;
+  } else {
+    fr.kind = QT_PROPOSAL_SQUARE;
+    fr.a0 = c.a0;
+    fr.a1 = c.a1;
+    fr.b0 = c.b0;
+    fr.b1 = c.b1;
+  }
+  return fr;
+}
+
+// The envelope of smallest volume among: the constant of the paper (margin x max f), exponentials
+// A exp(k1 (t1 - 1/2) + k2 (t2 - 1/2)) with slopes from a weighted least-squares fit of log f (and
+// scaled or one-axis variants), and, at the horizon of models with f ~ c^-s, A + B c^-s. Each
+// candidate's A is the smallest that keeps e >= margin f at every point evaluated in the cell.
+// V is the envelope's integral over the leaf's region: closed form for squares and polar cells,
+// the cell's quadrature (`quad`: points with weights) for squares cut by the inner circle.
+Envelope Builder::fit(const Cell& cell, const Frame& fr, const CellResult& all, const std::vector<Pt>& quad) {
+  const double margin = m_s.boundMargin, s = m_traits.rimExponent;
+  double measure;  // area of the proposal domain (disc measure)
+  if (fr.kind == QT_PROPOSAL_SQUARE) measure = (fr.a1 - fr.a0) * (fr.b1 - fr.b0);
+  else measure = 0.5 * (fr.a1 * fr.a1 - fr.a0 * fr.a0) * (fr.b1 - fr.b0) * M_PI;
+  // Points in proposal coordinates.
+  struct P {
+    double t1, t2, f, c;
+  };
+  std::vector<P> pts;
+  pts.reserve(all.pts.size());
+  for (const Pt& p : all.pts) {
+    if (!(p.f > 0)) continue;
+    P q;
+    fr.coords(p, q.t1, q.t2);
+    q.f = p.f;
+    q.c = p.c;
+    pts.push_back(q);
+  }
+  std::vector<P> qp;
+  if (fr.kind == QT_PROPOSAL_POLAR_CUT)
+    for (const Pt& p : quad) {
+      P q;
+      fr.coords(p, q.t1, q.t2);
+      q.f = p.w;  // weight
+      q.c = p.c;
+      qp.push_back(q);
+    }
+  auto volumeExp = [&](double k1, double k2, double A) {
+    if (fr.kind == QT_PROPOSAL_POLAR_CUT) {
+      double v = 0;
+      for (const P& q : qp) v += q.f * std::exp(k1 * (q.t1 - 0.5) + k2 * (q.t2 - 0.5));
+      return A * v;
+    }
+    return A * measure * expMass(k1) * expMass(k2);
+  };
+  auto amplitude = [&](double k1, double k2) {
+    double a = 0;
+    for (const P& q : pts) a = std::max(a, q.f * std::exp(-k1 * (q.t1 - 0.5) - k2 * (q.t2 - 0.5)));
+    return margin * a;
+  };
+  Envelope best;
+  best.A = margin * all.fmax;
+  best.V = volumeExp(0, 0, best.A);
+  best.trialV = best.A * measure;
+  if (pts.empty()) return best;
+  auto consider = [&](double k1, double k2) {
+    if (std::abs(k1) < QT_MIN_SLOPE) k1 = 0;
+    if (std::abs(k2) < QT_MIN_SLOPE) k2 = 0;
+    // Slopes up to 40 (a factor e^40 across the domain); squares cut by the inner circle measure V
+    // with their quadrature points, which resolve exp(k t) for |k| <= 8 only.
+    const double kMax = fr.kind == QT_PROPOSAL_POLAR_CUT ? 8.0 : 40.0;
+    k1 = std::clamp(k1, -kMax, kMax);
+    k2 = std::clamp(k2, -kMax, kMax);
+    if (k1 == 0 && k2 == 0) return;
+    double A = amplitude(k1, k2);
+    double V = volumeExp(k1, k2, A);
+    double trialV = A * measure * expMass(k1) * expMass(k2);
+    // A cut cell's proposal covers its polar box: an exponential that puts most of its mass outside
+    // the cell would waste trials on discards. At least a third of the proposal inside.
+    if (fr.kind == QT_PROPOSAL_POLAR_CUT && trialV > 3 * V) return;
+    if (V < best.V) best = Envelope{A, k1, k2, 0, V, trialV};
+  };
+  // Weighted least squares of log f = a + k1 t1 + k2 t2 (weights f: the fit matters where f is large).
+  double S[3][3] = {}, R[3] = {};
+  for (const P& q : pts) {
+    double w = q.f, l = std::log(q.f);
+    double b[3] = {1, q.t1 - 0.5, q.t2 - 0.5};
+    for (int i = 0; i < 3; ++i) {
+      R[i] += w * b[i] * l;
+      for (int j = 0; j < 3; ++j) S[i][j] += w * b[i] * b[j];
     }
   }
-  b.coA = float(std::min(1.0, std::sqrt(std::max(0.0, (1 - ra) * (1 + ra))) * (1 + 1e-6) + 1e-7));
-  return b;
+  // Solve the 3 x 3 system (Cramer).
+  auto det3 = [](double m[3][3]) {
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  };
+  double D = det3(S);
+  if (std::abs(D) > 1e-300) {
+    double sol[3];
+    for (int c = 0; c < 3; ++c) {
+      double M[3][3];
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) M[i][j] = j == c ? R[i] : S[i][j];
+      sol[c] = det3(M) / D;
+    }
+    double k1 = sol[1], k2 = sol[2];
+    if (std::isfinite(k1) && std::isfinite(k2)) {
+      consider(k1, k2);
+      consider(k1, 0);
+      consider(0, k2);
+      consider(0.6 * k1, 0.6 * k2);
+      consider(1.3 * k1, 1.3 * k2);
+    }
+  }
+  // f ~ c^-s at the horizon: A + B c^-s (V(B) = A(B) area + B zs is convex: golden section).
+  if (fr.kind == QT_PROPOSAL_POLAR && cell.a0 == 0 && s > 0) {
+    double zs = (std::pow(fr.a1, 2 - s) - std::pow(fr.a0, 2 - s)) / (2 - s) * (fr.b1 - fr.b0) * M_PI;  // int c^-s c dc dphi
+    std::vector<std::array<double, 2>> fc;  // (margin f_i, c_i^-s)
+    double bMax = 0;
+    for (const P& q : pts)
+      if (q.c > 0) {
+        double cs = std::pow(q.c, -s);
+        fc.push_back({margin * q.f, cs});
+        bMax = std::max(bMax, margin * q.f / cs);
+      }
+    auto hOf = [&](double b) {
+      double m = 0;
+      for (const auto& p : fc) m = std::max(m, p[0] - b * p[1]);
+      return m;
+    };
+    auto vOf = [&](double b) { return measure * hOf(b) + zs * b; };
+    double lo = 0, hi = bMax;
+    const double gr = 0.5 * (std::sqrt(5.0) - 1);
+    double b1 = hi - gr * (hi - lo), b2 = lo + gr * (hi - lo);
+    double v1 = vOf(b1), v2 = vOf(b2);
+    for (int it = 0; it < 48 && hi - lo > 1e-9 * bMax; ++it) {
+      if (v1 <= v2) { hi = b2; b2 = b1; v2 = v1; b1 = hi - gr * (hi - lo); v1 = vOf(b1); }
+      else { lo = b1; b1 = b2; v1 = v2; b2 = lo + gr * (hi - lo); v2 = vOf(b2); }
+    }
+    for (double b : {b1, b2, bMax})
+      if (b > 0 && vOf(b) < best.V) best = Envelope{hOf(b), 0, 0, b, vOf(b), vOf(b)};
+  }
+  return best;
+}
+
+// The envelope of a leaf, checked between its points: from the three points where f / e is largest,
+// a pattern search in the proposal coordinates (steps 1/16 of the domain, halved when no
+// neighbour is higher) climbs to the local maximum of f / e, which a narrow ridge or peak between
+// the grid and Gauss points can hide.
+void Builder::polish(const Cell& cell, const Frame& fr, CellResult& all, Envelope& env) {
+  const double s = m_traits.rimExponent;
+  auto envAt = [&](double t1, double t2, double c) {
+    double e = env.A * std::exp(env.k1 * (t1 - 0.5) + env.k2 * (t2 - 0.5));
+    if (env.B > 0) e += env.B * std::pow(c, -s);
+    return e;
+  };
+  // f / e at proposal coordinates (t1, t2); -1 outside the leaf's region.
+  auto ratioAt = [&](double t1, double t2) {
+    if (t1 < 0 || t1 > 1 || t2 < 0 || t2 > 1) return -1.0;
+    double x, y, c;
+    if (fr.kind == QT_PROPOSAL_SQUARE) {
+      x = fr.a0 + t1 * (fr.a1 - fr.a0);
+      y = fr.b0 + t2 * (fr.b1 - fr.b0);
+      double r2 = x * x + y * y;
+      if (r2 >= kInnerR2) return -1.0;
+      c = std::sqrt(1 - r2);
+    } else {
+      double u0 = fr.a0 * fr.a0, u1 = fr.a1 * fr.a1;
+      c = std::sqrt(u0 + t1 * (u1 - u0));
+      if (!(float(c) > 0)) return -1.0;
+      double ph = M_PI * (fr.b0 + t2 * (fr.b1 - fr.b0)), rr = std::sqrt((1 - c) * (1 + c));
+      x = rr * std::cos(ph);
+      y = rr * std::sin(ph);
+      if (fr.kind == QT_PROPOSAL_POLAR_CUT && (x < cell.a0 || x > cell.a1 || y < cell.b0 || y > cell.b1)) return -1.0;
+    }
+    double f = quadEvalLum(m_model, m_params, vec3(float(x), float(y), float(c)), m_v);
+    ++m_evals;
+    all.pts.push_back({float(x), float(y), float(c), NAN, float(f), -1});
+    return f / envAt(t1, t2, c);
+  };
+  // Seeds: the three points of largest f / e.
+  constexpr int kSeeds = 3;
+  double best[kSeeds][3];  // ratio, t1, t2
+  for (auto& b : best) b[0] = -1, b[1] = b[2] = 0;
+  for (const Pt& p : all.pts) {
+    if (!(p.f > 0) || !(p.c > 0)) continue;
+    double t1, t2;
+    fr.coords(p, t1, t2);
+    double r = p.f / envAt(t1, t2, double(p.c));
+    for (int k = 0; k < kSeeds; ++k)
+      if (r > best[k][0]) {
+        for (int m = kSeeds - 1; m > k; --m)
+          for (int q = 0; q < 3; ++q) best[m][q] = best[m - 1][q];
+        best[k][0] = r; best[k][1] = t1; best[k][2] = t2;
+        break;
+      }
+  }
+  double top = best[0][0];
+  for (auto& b : best) {
+    if (b[0] <= 0) continue;
+    double r = b[0], t1 = b[1], t2 = b[2], step = 1.0 / 16;
+    for (int it = 0; it < 12 && step > 1.0 / 8192; ++it) {
+      bool moved = false;
+      const double d[4][2] = {{step, 0}, {-step, 0}, {0, step}, {0, -step}};
+      for (const auto& dd : d) {
+        double q = ratioAt(t1 + dd[0], t2 + dd[1]);
+        if (q > r) { r = q; t1 += dd[0]; t2 += dd[1]; moved = true; break; }
+      }
+      if (!moved) step *= 0.5;
+    }
+    top = std::max(top, r);
+  }
+  // Where the search climbed above what the points saw (f / e above 1 / margin), the envelope
+  // grows to keep its margin there too.
+  double scale = m_s.boundMargin * top;
+  if (scale > 1) {
+    env.A *= scale;
+    env.B *= scale;
+    env.V *= scale;
+    env.trialV *= scale;
+  }
 }
 
 struct Item {
-  float x0, y0, size;
-  std::uint32_t depth;
-  std::uint32_t parent, slot;  // parent node (QT_EMPTY for the root)
+  Cell cell;
+  std::uint32_t parent, slot;
   CellResult res;
 };
 
 Tree Builder::build() {
   Tree tree;
-  std::vector<Item> stack;
-  Item root{-1.0f, -1.0f, 2.0f, 0, QT_EMPTY, 0, integrate(-1, 1, -1, 1)};
-  double aEst = -1, running = 0;
-  stack.push_back(root);
   const float s = m_traits.rimExponent;
+  // Root children (quadtree_layout.h).
+  std::vector<Cell> roots;
+  auto square = [](double x0, double x1, double y0, double y1) {
+    Cell c;
+    c.a0 = x0; c.a1 = x1; c.b0 = y0; c.b1 = y1; c.depth = 1;
+    return c;
+  };
+  auto polarCell = [](double t0, double t1) {
+    Cell c;
+    c.polar = true;
+    c.a0 = 0; c.a1 = kRimCos; c.b0 = t0; c.b1 = t1; c.depth = 1;
+    return c;
+  };
+  if (m_half) roots = {square(-1, 0, 0, 1), square(0, 1, 0, 1), polarCell(0, 1)};
+  else roots = {square(-1, 1, -1, 1), polarCell(0, 1), polarCell(1, 2)};
+
+  QuadNode rootNode;
+  rootNode.mass = vec4(0.0f);
+  rootNode.child = uvec4(QT_EMPTY);
+  tree.nodes.push_back(rootNode);
+  tree.root = 0;
+
+  std::vector<Item> stack;
+  m_aEst = 0;
+  for (std::size_t k = 0; k < roots.size(); ++k) {
+    CellResult r = integrate(roots[k]);
+    m_aEst += r.q;
+    stack.push_back({roots[k], 0, std::uint32_t(k), std::move(r)});
+  }
+  std::reverse(stack.begin(), stack.end());
+  double running = m_aEst;
   while (!stack.empty()) {
     Item it = std::move(stack.back());
     stack.pop_back();
-    double x0 = it.x0, y0 = it.y0, h = 0.5 * it.size;
-    CellResult child[4];
     CellResult all = std::move(it.res);
     double parentQ = all.q;
-    double sumq = 0, area = 0, zs = 0;
+    boundPoints(it.cell, all);
+    // A polar cell whose own rule does not resolve it (a streak between its Gauss points) splits
+    // 2 x 2; otherwise along the axis its rule sees varying.
+    if (it.cell.polar) it.cell.split = resolved(all) ? choosePolarSplit(it.cell, all) : 0;
+    const Cell& cell = it.cell;
+    auto link = [&](std::uint32_t value) { tree.nodes[it.parent].child[it.slot] = value; };
+    std::array<Cell, 4> ch = children(cell);
+    CellResult child[4];
+    double sumq = 0;
+    std::vector<Pt> quad;  // the children's quadrature points (weights): V of cut cells
     for (int c = 0; c < 4; ++c) {
-      double cx0 = x0 + ((c & 1) ? h : 0), cy0 = y0 + ((c & 2) ? h : 0);
-      child[c] = integrate(cx0, cx0 + h, cy0, cy0 + h);
+      if (ch[c].outside()) continue;
+      child[c] = integrate(ch[c]);
       sumq += child[c].q;
-      area += child[c].area;
-      zs += child[c].zs;
       all.fmax = std::max(all.fmax, child[c].fmax);
       all.anyPositive = all.anyPositive || child[c].anyPositive;
-      all.pts.insert(all.pts.end(), child[c].pts.begin(), child[c].pts.end());
+      for (const Pt& p : child[c].pts) {
+        all.pts.push_back(p);
+        if (p.w > 0) quad.push_back(p);
+      }
     }
-    // Running estimate of the total (leaves so far + pending cells): the scale of the absolute
-    // tolerances. A lobe missed by the root's quadrature raises it as soon as it is resolved.
-    if (aEst < 0) { aEst = std::max(sumq, parentQ); running = sumq; }
-    else running += sumq - parentQ;
-    aEst = std::max(aEst, running);
-    boundPoints(x0, x0 + it.size, y0, y0 + it.size, all);
-
-    auto link = [&](std::uint32_t value) {
-      if (it.parent == QT_EMPTY) tree.root = value;
-      else tree.nodes[it.parent].child[it.slot] = value;
-    };
+    // Running estimate of the total (the scale of the absolute tolerances): a lobe missed by a
+    // coarse rule raises it as soon as it is resolved.
+    running += sumq - parentQ;
+    m_aEst = std::max(m_aEst, running);
     if (!all.anyPositive) {  // f = 0 at every point evaluated, peaks included
       link(QT_EMPTY);
       ++tree.stats.emptyChildren;
       continue;
     }
-    float fx = std::max(std::abs(it.x0), std::abs(it.x0 + it.size)),
-          fy = std::max(std::abs(it.y0), std::abs(it.y0 + it.size));
-    // Envelope e >= f on R = (cell & disc); V = integral of e over R. Cells inside the disc:
-    // e = M, proposal uniform in the square. Cells cut by the rim: e = A + B cos^-s, proposal the
-    // polar box of R (points outside the cell rejected before f is evaluated), so V is measured on
-    // R itself, not on the box: a square cut diagonally by the rim no longer pays for the part of
-    // its proposal outside the disc, and acceptance I / V tends to 1 / margin as cells shrink.
-    bool cut = fx * fx + fy * fy > 1.0f;
-    double A = m_s.boundMargin * all.fmax, B = 0, V;
+    // Four slices along one axis test the rule along the other one not at all: then the mass is
+    // refined 2 x 2 (refine) before it is trusted.
+    bool accurate = std::abs(parentQ - sumq) <= tolerance(sumq) && cell.depth + 1 >= kMinIntegrationDepth &&
+                    (!cell.polar || cell.split == 0);
     PolarBox box;
-    if (cut) {
-      box = polarBox(it.x0, it.x0 + it.size, it.y0, it.y0 + it.size);
-      if (s > 0) fitEnvelope(all, area, zs, A, B);
-      V = A * area + B * zs;
-    } else {
-      V = A * double(it.size) * double(it.size);
+    Frame fr = frameOf(cell, &box);
+    Envelope env = fit(cell, fr, all, quad);
+    bool capped = cell.depth >= m_s.maxDepth;
+    auto accepts = [&](double q, const Envelope& e) { return m_s.nMax * q >= e.V; };
+    // Tail cells (negligible mass) stop refining below 1/n_max, but not below 1/16 of their
+    // trials (the trial cap), unless their mass is below 1e-12 a (never sampled in practice).
+    auto tailOk = [&](double q, const Envelope& e) {
+      return (q < m_s.tailTol * m_aEst && 16 * q >= e.trialV) || q < 1e-12 * m_aEst;
+    };
+    // Leaves only where the children's quadrature sees what the bound points see (or at the cap).
+    const bool seen = resolved(all);
+    bool leaf = (seen && (accepts(sumq, env) || tailOk(sumq, env))) || capped;
+    double mass = sumq;
+    if (leaf && !accurate) {
+      // The leaf's mass by adaptive integration inside it (no tree nodes); its new points refine
+      // the envelope too.
+      double total = 0;
+      for (int c = 0; c < 4; ++c)
+        if (child[c].anyPositive) total += refine(ch[c], child[c], all, 12);
+        else total += child[c].q;
+      running += total - sumq;
+      m_aEst = std::max(m_aEst, running);
+      mass = total;
+      env = fit(cell, fr, all, quad);
+      leaf = (seen && (accepts(mass, env) || tailOk(mass, env))) || capped;
+      if (!leaf) {
+        // Split after all: the children start from their basic rules again.
+        running -= total - sumq;
+      }
     }
-    bool rim = cut;
-    double M = A;
-    bool accurate = std::abs(parentQ - sumq) <= std::max(m_s.relTol * sumq, m_s.absTol * aEst);
-    bool accepts = m_s.nMax * sumq >= V;
-    // Tail cells (negligible mass) stop refining even when their acceptance is below 1/n_max.
-    bool tail = sumq < m_s.tailTol * aEst;
-    if ((accurate && (accepts || tail)) || it.depth >= m_s.maxDepth) {
-      if (sumq <= 0) {
+    if (leaf && mass > 0) {
+      polish(cell, fr, all, env);
+      if (!capped && !(accepts(mass, env) || tailOk(mass, env))) {
+        leaf = false;  // the envelope had to grow: split after all
+        running -= mass - sumq;
+      }
+    }
+    if (leaf) {
+      // A leaf whose mass is below 1e-30 of the total is never chosen by a float descent, and its
+      // float envelope can underflow: it is left out (a bias below 1e-30).
+      if (mass <= 1e-30 * m_aEst) {
         link(QT_EMPTY);
         ++tree.stats.emptyChildren;
         continue;
       }
-      QuadLeaf leaf;
-      leaf.data = vec4(float(M), float(sumq), rim ? float(QT_PROPOSAL_RIM) : float(QT_PROPOSAL_UNIFORM), rim ? s : 0.0f);
-      leaf.box = rim ? vec4(box.coA, box.pa, box.dp, float(B)) : vec4(0.0f);
+      QuadLeaf L;
+      L.data = vec4(float(env.A), float(mass), float(fr.kind), env.B > 0 ? s : 0.0f);
+      L.env = vec4(float(env.k1), float(env.k2), float(env.B), 0.0f);
+      L.box = fr.kind == QT_PROPOSAL_SQUARE ? vec4(0.0f) : vec4(float(fr.a0), float(fr.a1), float(fr.b0), float(fr.b1));
       link(QT_LEAF_BIT | std::uint32_t(tree.leaves.size()));
-      tree.leaves.push_back(leaf);
+      tree.leaves.push_back(L);
       tree.stats.leaves++;
-      if (!accepts) {
-        if (tail) tree.stats.tailLeaves++;
-        else tree.stats.cappedLeaves++;
-        tree.stats.lowAcceptanceMass += sumq;
+      bool good = accepts(mass, env);
+      if (!good) {
+        if (capped) tree.stats.cappedLeaves++;
+        else tree.stats.tailLeaves++;
+        tree.stats.lowAcceptanceMass += mass;
       }
-      if (rim) tree.stats.rimLeaves++;
-      tree.stats.maxDepth = std::max(tree.stats.maxDepth, it.depth);
-      if (!tail || accepts) tree.stats.minAcceptance = std::min(tree.stats.minAcceptance, V > 0 ? sumq / V : 1.0);
+      if (fr.kind != QT_PROPOSAL_SQUARE) tree.stats.rimLeaves++;
+      if (env.k1 != 0 || env.k2 != 0) tree.stats.expLeaves++;
+      if (env.B > 0) tree.stats.singularLeaves++;
+      tree.stats.maxDepth = std::max(tree.stats.maxDepth, cell.depth);
+      if (good) tree.stats.minAcceptance = std::min(tree.stats.minAcceptance, env.V > 0 ? mass / env.V : 1.0);
       continue;
     }
     std::uint32_t index = std::uint32_t(tree.nodes.size());
@@ -526,10 +997,8 @@ Tree Builder::build() {
     tree.nodes.push_back(node);
     link(index);
     for (int c = 3; c >= 0; --c) {
-      float hh = 0.5f * it.size;
-      Item ch{it.x0 + ((c & 1) ? hh : 0.0f), it.y0 + ((c & 2) ? hh : 0.0f), hh, it.depth + 1, index,
-              std::uint32_t(c), std::move(child[c])};
-      stack.push_back(ch);
+      if (ch[c].outside()) continue;
+      stack.push_back({ch[c], index, std::uint32_t(c), std::move(child[c])});
     }
   }
   // Masses, bottom-up: children are created after their parents.
@@ -538,19 +1007,23 @@ Tree Builder::build() {
     QuadNode& n = tree.nodes[i];
     double total = 0;
     for (int c = 0; c < 4; ++c) {
-      std::uint32_t ch = n.child[c];
+      std::uint32_t l = n.child[c];
       double m = 0;
-      if (ch == QT_EMPTY) m = 0;
-      else if (ch & QT_LEAF_BIT) m = tree.leaves[ch & ~QT_LEAF_BIT].data.y;
-      else m = nodeMass[ch];
+      if (l == QT_EMPTY) m = 0;
+      else if (l & QT_LEAF_BIT) m = tree.leaves[l & ~QT_LEAF_BIT].data.y;
+      else m = nodeMass[l];
       n.mass[c] = float(m);
       total += m;
     }
     nodeMass[i] = total;
   }
-  if (tree.root == QT_EMPTY) tree.mass = 0;
-  else if (tree.root & QT_LEAF_BIT) tree.mass = tree.leaves[tree.root & ~QT_LEAF_BIT].data.y;
-  else tree.mass = nodeMass[tree.root];
+  tree.mass = nodeMass[0] * (m_half ? 2.0 : 1.0);
+  if (tree.mass <= 0) {
+    tree.nodes.clear();
+    tree.leaves.clear();
+    tree.root = QT_EMPTY;
+    tree.mass = 0;
+  }
   tree.stats.nodes = std::uint32_t(tree.nodes.size());
   tree.stats.evaluations = m_evals;
   return tree;
@@ -558,8 +1031,82 @@ Tree Builder::build() {
 
 }  // namespace
 
+void forEachLeaf(const QuadNode* nodes, const QuadLeaf* leaves, std::uint32_t root, bool anisotropic,
+                 const std::function<void(std::uint32_t, const QuadLeaf&, double, double, double)>& fn) {
+  if (root == QT_EMPTY) return;
+  struct C { std::uint32_t link; double x0, y0, size; };
+  const QuadNode& R = nodes[root];
+  std::vector<C> stack;
+  if (anisotropic) stack = {{R.child[2], 0, 0, 0}, {R.child[1], 0, 0, 0}, {R.child[0], -1, -1, 2}};
+  else stack = {{R.child[2], 0, 0, 0}, {R.child[1], 0, 0, 1}, {R.child[0], -1, 0, 1}};
+  while (!stack.empty()) {
+    C c = stack.back();
+    stack.pop_back();
+    if (c.link == QT_EMPTY) continue;
+    if (c.link & QT_LEAF_BIT) {
+      std::uint32_t l = c.link & ~QT_LEAF_BIT;
+      fn(l, leaves[l], c.x0, c.y0, c.size);
+      continue;
+    }
+    const QuadNode& n = nodes[c.link];
+    double h = 0.5 * c.size;
+    for (int k = 3; k >= 0; --k) stack.push_back({n.child[k], c.x0 + ((k & 1) ? h : 0), c.y0 + ((k & 2) ? h : 0), h});
+  }
+}
+
+EnvelopeAudit auditEnvelopes(std::uint32_t model, const BrdfParams& params, vec3 v, const Tree& tree, int grid) {
+  return auditEnvelopes(model, params, v, tree.nodes.data(), tree.leaves.data(), tree.root, tree.mass, grid);
+}
+
+EnvelopeAudit auditEnvelopes(std::uint32_t model, const BrdfParams& params, vec3 v, const QuadNode* nodes, const QuadLeaf* leaves,
+                             std::uint32_t root, double mass, int grid) {
+  EnvelopeAudit a;
+  if (root == QT_EMPTY) return a;
+  const bool aniso = modelTraits(model, params).anisotropic;
+  forEachLeaf(nodes, leaves, root, aniso,
+              [&](std::uint32_t, const QuadLeaf& L, double x0, double y0, double size) {
+                if (L.data.y < 1e-20 * mass) return;
+                ++a.leaves;
+                const std::uint32_t kind = std::uint32_t(L.data.z + 0.5f);
+                const double A = L.data.x, s = L.data.w, k1 = L.env.x, k2 = L.env.y, B = L.env.z;
+                double worst = 0;
+                for (int i = 0; i <= grid; ++i)
+                  for (int j = 0; j <= grid; ++j) {
+                    double t1 = double(i) / grid, t2 = double(j) / grid, x, y, c;
+                    if (kind == QT_PROPOSAL_SQUARE) {
+                      x = x0 + size * t1;
+                      y = y0 + size * t2;
+                      double r2 = x * x + y * y;
+                      if (r2 >= 1) continue;
+                      c = std::sqrt(1 - r2);
+                    } else {
+                      double u0 = double(L.box.x) * L.box.x, u1 = double(L.box.y) * L.box.y;
+                      c = std::sqrt(u0 + t1 * (u1 - u0));
+                      if (!(float(c) > 0)) continue;
+                      double r = std::sqrt((1 - c) * (1 + c)), ph = M_PI * (L.box.z + t2 * (double(L.box.w) - L.box.z));
+                      x = r * std::cos(ph);
+                      y = r * std::sin(ph);
+                      if (kind == QT_PROPOSAL_POLAR_CUT && (x < x0 || x > x0 + size || y < y0 || y > y0 + size)) continue;
+                    }
+                    double e = A * std::exp(k1 * (t1 - 0.5) + k2 * (t2 - 0.5)) + (B > 0 ? B * std::pow(c, -s) : 0.0);
+                    double f = quadEvalLum(model, params, vec3(float(x), float(y), float(c)), v);
+                    ++a.evaluations;
+                    if (f > 0) worst = std::max(worst, e > 0 ? f / e : INFINITY);
+                  }
+                a.worst = std::max(a.worst, worst);
+                if (worst > 1) {
+                  ++a.leavesAbove;
+                  a.massAbove += L.data.y;
+                }
+              });
+  return a;
+}
+
 Tree buildTree(std::uint32_t model, const BrdfParams& params, vec3 v, const BuildSettings& settings) {
-  Builder b(model, params, v, settings);
+  // Isotropic sets tabulate v at azimuth 0, where f(., v) is symmetric in w.y: the half disc.
+  bool half = !modelTraits(model, params).anisotropic;
+  if (half && v.y != 0.0f) throw std::invalid_argument("quadtree::buildTree: isotropic model with v.y != 0");
+  Builder b(model, params, v, half, settings);
   return b.build();
 }
 

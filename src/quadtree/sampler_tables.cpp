@@ -24,7 +24,7 @@ using namespace shared;
 namespace {
 
 // Bump when the tree format or the build algorithm changes: old cache entries become stale.
-constexpr std::uint32_t kFormatVersion = 5;  // 5: rim envelope A + B cos^-s on (cell & disc)
+constexpr std::uint32_t kFormatVersion = 6;  // 6: polar rim annulus, half disc, exponential envelopes, 48-byte leaves
 constexpr char kMagic[8] = {'N', 'U', 'S', 'Q', 'T', 'R', 'E', 'E'};
 
 std::uint64_t fnv1a(const void* data, std::size_t n, std::uint64_t h = 1469598103934665603ull) {
@@ -50,7 +50,7 @@ struct CacheHeader {
   std::uint32_t tables, nodes, leaves;
   std::uint64_t key;
   std::uint64_t checksum;  // of the payload
-  std::uint32_t cappedLeaves, rimLeaves, maxDepth, pad;
+  std::uint32_t cappedLeaves, rimLeaves, maxDepth, tailLeaves, expLeaves, pad;
   double minAcceptance;
 };
 
@@ -102,6 +102,8 @@ int loadCache(std::uint64_t key, MaterialTrees& out) {
     }
   out.stats.cappedLeaves = h.cappedLeaves;
   out.stats.rimLeaves = h.rimLeaves;
+  out.stats.tailLeaves = h.tailLeaves;
+  out.stats.expLeaves = h.expLeaves;
   out.stats.maxDepth = h.maxDepth;
   out.stats.minAcceptance = h.minAcceptance;
   return 0;
@@ -123,6 +125,8 @@ void storeCache(std::uint64_t key, const MaterialTrees& m) {
   h.checksum = sum;
   h.cappedLeaves = m.stats.cappedLeaves;
   h.rimLeaves = m.stats.rimLeaves;
+  h.tailLeaves = m.stats.tailLeaves;
+  h.expLeaves = m.stats.expLeaves;
   h.maxDepth = m.stats.maxDepth;
   h.minAcceptance = m.stats.minAcceptance;
   // Write to a unique temporary, then rename: readers never see a partial file.
@@ -305,6 +309,8 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
         u.trees.tables[t].data.x = float(tr.mass);
         st.cappedLeaves += tr.stats.cappedLeaves;
         st.rimLeaves += tr.stats.rimLeaves;
+        st.tailLeaves += tr.stats.tailLeaves;
+        st.expLeaves += tr.stats.expLeaves;
         st.maxDepth = std::max(st.maxDepth, tr.stats.maxDepth);
         st.minAcceptance = std::min(st.minAcceptance, tr.stats.minAcceptance);
         st.evaluations += tr.stats.evaluations;

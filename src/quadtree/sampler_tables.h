@@ -29,6 +29,7 @@ struct MaterialStats {
   std::uint32_t model = 0;
   std::uint32_t set = INVALID_INDEX;
   std::uint32_t trees = 0, nodes = 0, leaves = 0, cappedLeaves = 0, rimLeaves = 0, maxDepth = 0;
+  std::uint32_t tailLeaves = 0, expLeaves = 0;  // negligible-mass leaves below 1/n_max; exponential envelopes
   double minAcceptance = 1;
   std::uint64_t bytes = 0;
   std::uint64_t evaluations = 0;

@@ -1,16 +1,28 @@
-// test_quadtree_chi2.h: chi-square goodness of fit of the generic sampler (as Mitsuba 3 tests
-// BSDFs), shared by the CPU (tests/unit/test_quadtree.cpp) and GPU (tests/gpu/test_quadtree_gpu.cpp)
-// tests. Bins: the unit disc in equal-area rings (r^2) x sectors; expected counts: the sampler's
-// own pdf (quadPdf, per solid angle, divided by cos: disc measure) integrated over each bin by
-// adaptive Gauss-Legendre; bins below 5 expected are pooled; p-value of the chi-square statistic.
+// test_quadtree_chi2.h: chi-square goodness of fit of sampled directions against a pdf (as
+// Mitsuba 3 tests its BSDFs), shared by the quadtree tests (tests/unit/test_quadtree.cpp, CPU;
+// tests/gpu/test_quadtree_gpu.cpp, GPU) and the other strategies' (tests/unit/test_strategies.cpp).
+//
+// Bins: rings in c = cos theta times sectors in phi. Either fixed (equal-area rings, equal sectors)
+// or equal-probability bins from an independent pilot sample (quantiles of c, then of phi within
+// each ring): the bins follow the lobe, however narrow or grazing, so that the test keeps its
+// power there; the partition does not depend on the tested samples, and the expected counts come
+// from the pdf alone (adaptive Gauss-Legendre over each bin), so a wrong sampler is still caught.
+// Failed samples (pdf 0) form one more bin whose probability is 1 - sum of the others; bins below
+// 5 expected are pooled; the p-value is that of the chi-square statistic.
 #pragma once
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
+#include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "brdf/registry.h"
+#include "quadtree/quadtree_build.h"
 #include "quadtree/sample_run.h"
 #include "quadtree/sampler_tables.h"
 
@@ -29,79 +41,38 @@ struct Case {
   }
 };
 
-inline bool fullMatrix() {
-  const char* e = std::getenv("NUSSELT_QT_FULL");
-  return e && std::string(e) != "0";
-}
-
-// Tables used by the tests: 18 along theta (5 degree steps: 0, 30, 60, 85 are tabulated, 37.3 lies
-// between 35 and 40), 4 along phi for anisotropic models. By default only the theta tables the
-// cases use are built (0, 30, 35, 40, 60, 85 degrees; the others stay empty): the build of all
-// tables is measured by `nusselt bench precompute`, not here. NUSSELT_QT_FULL=1 builds all 18.
+// The quadtree suite's tables: the production grid (90 theta tables, 16 phi tables), of which only
+// those the cases use are built (0, 30, 37, 38, 60, 85 degrees and their phi tables; 37.3 lies
+// between 37 and 38); the build of all of them is measured by `nusselt bench precompute`.
 inline quadtree::QuadtreeSettings testSettings() {
   quadtree::QuadtreeSettings s;
-  s.thetaTables = 18;
-  s.phiTables = 4;
   s.useCache = false;
-  if (!fullMatrix()) s.onlyThetaTables = {0, 6, 7, 8, 12, 17};
+  s.onlyThetaTables = {0, 30, 37, 38, 60, 85};
   return s;
 }
 
-// The default matrix: every model, typical and hard, at 37.3 deg (between tables) and one
-// tabulated angle chosen by model (0, 30, 60, 85 in turn: all four are covered across models),
-// plus azimuth 20 deg (between phi tables) for anisotropic sets. NUSSELT_QT_FULL=1: all five
-// angles for every model and set.
+// Every non-delta model, typical and hard, at 0, 30, 60, 85 degrees (tables) and 37.3 (between
+// tables), plus azimuth 20 degrees (between phi tables) at 37.3 and 60 for the anisotropic sets.
 inline std::vector<Case> caseMatrix() {
-  bool full = fullMatrix();
   std::vector<Case> cases;
-  const double tab[4] = {0, 30, 60, 85};
-  int k = 0;
   for (const ModelSpec& m : allModels()) {
     if (m.delta) continue;
     for (int hard = 0; hard < 2; ++hard) {
-      std::vector<double> angles{37.3};
-      if (full) angles = {0, 30, 60, 85, 37.3};
-      else angles.push_back(tab[k % 4]);
-      for (double a : angles) cases.push_back({m.name, hard != 0, a, 0});
-      if (m.id == MODEL_POULIN_FOURNIER || (hard && (m.id == MODEL_WARD || m.id == MODEL_ASHIKHMIN_SHIRLEY || m.id == MODEL_SCHLICK)))
-        cases.push_back({m.name, hard != 0, 37.3, 20});  // anisotropic: azimuth between tables
-      ++k;
+      for (double a : {0.0, 30.0, 60.0, 85.0, 37.3}) cases.push_back({m.name, hard != 0, a, 0});
+      BrdfParams p = packParams(m, hard ? hardParams(m) : typicalParams(m), m.name);
+      if (quadtree::modelTraits(m.id, p).anisotropic)
+        for (double a : {37.3, 60.0}) cases.push_back({m.name, hard != 0, a, 20});
     }
   }
   return cases;
 }
 
-// Cases that are known to fail (name prefix "model/preset"), with the reason; the tests print
-// this list and report these cases without failing. Empty is the goal.
-struct KnownFailure {
-  const char* prefix;
-  const char* reason;
-};
-inline const std::vector<KnownFailure>& knownFailures() {
-  static const std::vector<KnownFailure> list = {
-      {"schlick/hard", "leaves at the depth cap along the rim (multiple-reflection term, p = 0.1) accept far below "
-                       "1/n_max (measured z = -70 at 85 deg): 69 trial failures and 1 bound violation in 200k "
-                       "samples at 85 deg, 1 trial failure at 37.3; chi-square passes"},
-      {"beard_maxwell/hard", "capped rim leaves at 85 deg accept far below 1/n_max (z = -53): 34 trial failures in 200k"},
-      {"poulin_fournier/hard", "one capped leaf accepts below 1/n_max (z = -11 at 37.3/20); no failures, chi-square passes"},
-      {"gltf_pbr/hard/theta=85", "capped rim leaves (roughness 0.05 metal at grazing) accept below 1/n_max (z = -11); "
-                                 "1 trial failure in 200k GPU samples; chi-square passes"},
-      {"totals:beard_maxwell/typical/theta=85", "tree total 1.3282345 is 2.1e-4 low; directionalAlbedo 1.3285168 and an "
-                                                "independent (cos, phi) quadrature 1.3285169 agree: the tree's rim integral"},
-      {"totals:strauss/hard/theta=85", "tree total 0.0174779 vs 0.0174801 from a quadrature over the first argument "
-                                       "(1.3e-4, target 1e-4); not yet known which side is wrong"},
-  };
-  return list;
-}
-inline const char* knownFailure(const std::string& name) {
-  for (const KnownFailure& k : knownFailures())
-    if (name.rfind(k.prefix, 0) == 0) return k.reason;
-  return nullptr;
-}
-inline void printKnownFailures() {
-  std::printf("known failures (%zu):\n", knownFailures().size());
-  for (const KnownFailure& k : knownFailures()) std::printf("  %s: %s\n", k.prefix, k.reason);
-}
+// Samples per case (about a million, as Mitsuba's tests) and per pilot run (the bins).
+constexpr std::uint32_t kSamples = 1u << 20;
+constexpr std::uint32_t kPilotSamples = 1u << 15;
+
+// Bonferroni: significance 0.01 over every chi-square case of the quadtree suite, CPU and GPU.
+inline double suiteAlpha() { return 0.01 / (2.0 * double(caseMatrix().size())); }
 
 // Regularized upper incomplete gamma Q(a, x) (Numerical Recipes gser / gcf).
 inline double gammaQ(double a, double x) {
@@ -133,96 +104,259 @@ inline double gammaQ(double a, double x) {
   return std::exp(-x + a * std::log(x) - gln) * h;
 }
 
-// 16 equal-area rings x 32 sectors: 512 bins (about 400 samples per bin at 200k samples).
-constexpr int kRings = 16, kSectors = 32;
+// Rings [c[i], c[i+1]] (ascending, c[0] = 0, c.back() = 1) times sectors [phi[i][j], phi[i][j+1]]
+// covering [phi[i][0], phi[i][0] + 2 pi).
+struct Binning {
+  std::vector<double> c;
+  std::vector<std::vector<double>> phi;
+  std::size_t size() const {
+    std::size_t n = 0;
+    for (const auto& p : phi) n += p.size() - 1;
+    return n;
+  }
+  // Bin of direction w (upper hemisphere), rings first.
+  std::size_t bin(vec3 w) const {
+    double cz = std::clamp(double(w.z), 0.0, 1.0);
+    std::size_t i = std::min<std::size_t>(c.size() - 2, std::size_t(std::upper_bound(c.begin(), c.end(), cz) - c.begin()) - 1);
+    const std::vector<double>& e = phi[i];
+    double ph = std::atan2(double(w.y), double(w.x));
+    while (ph < e.front()) ph += 2 * M_PI;
+    while (ph >= e.front() + 2 * M_PI) ph -= 2 * M_PI;
+    std::size_t j = std::min<std::size_t>(e.size() - 2, std::size_t(std::upper_bound(e.begin(), e.end(), ph) - e.begin()) - 1);
+    std::size_t base = 0;
+    for (std::size_t k = 0; k < i; ++k) base += phi[k].size() - 1;
+    return base + j;
+  }
+};
 
-// Integral of the disc density (quadPdf / cos) over one bin [u0, u1] x [p0, p1] (u = r^2),
-// adaptive 4 x 4 Gauss-Legendre in (c = cos theta, phi), dA = c dc dphi: the disc density of the
-// models unbounded at the rim (~ 1 / c) times c is bounded there.
-inline double binIntegral(std::uint32_t set, std::uint32_t model, const BrdfParams& p, vec3 v, double u0, double u1, double p0,
-                          double p1, int depth = 0) {
+// Equal-area rings (in r^2) and equal sectors from phi = 0.
+inline Binning uniformBinning(int rings, int sectors) {
+  Binning b;
+  for (int i = 0; i <= rings; ++i) b.c.push_back(std::sqrt(double(i) / rings));  // c^2 = 1 - r^2: equal steps
+  b.c.front() = 0;
+  b.c.back() = 1;
+  for (int i = 0; i < rings; ++i) {
+    std::vector<double> e;
+    for (int j = 0; j <= sectors; ++j) e.push_back(2 * M_PI * j / sectors);
+    b.phi.push_back(e);
+  }
+  return b;
+}
+
+// Equal-probability bins of an independent pilot sample (pdf 0 = failed, ignored).
+inline Binning quantileBinning(const std::vector<vec4>& pilot, int rings, int sectors) {
+  std::vector<std::pair<double, double>> pts;  // (c, phi)
+  for (const vec4& s : pilot)
+    if (s.w > 0) pts.push_back({std::clamp(double(s.z), 0.0, 1.0), std::atan2(double(s.y), double(s.x))});
+  if (pts.size() < std::size_t(rings * sectors * 4)) return uniformBinning(rings, sectors);
+  std::sort(pts.begin(), pts.end());
+  Binning b;
+  b.c.push_back(0);
+  std::size_t n = pts.size();
+  for (int i = 1; i < rings; ++i) b.c.push_back(pts[i * n / rings].first);
+  b.c.push_back(1);
+  for (int i = 0; i < rings; ++i) {
+    std::vector<double> ph;
+    for (std::size_t k = i * n / rings; k < (i + 1) * n / rings; ++k) ph.push_back(pts[k].second);
+    std::sort(ph.begin(), ph.end());
+    std::vector<double> e{-M_PI};
+    for (int j = 1; j < sectors; ++j) e.push_back(ph[j * ph.size() / sectors]);
+    e.push_back(M_PI);
+    // Equal quantiles can coincide only for an atom (none here); keep the edges strictly ascending.
+    for (std::size_t j = 1; j < e.size(); ++j) e[j] = std::max(e[j], std::nextafter(e[j - 1], 10.0));
+    b.phi.push_back(e);
+  }
+  // Strictly ascending rings too.
+  for (std::size_t i = 1; i < b.c.size(); ++i) b.c[i] = std::max(b.c[i], std::nextafter(b.c[i - 1], 10.0));
+  b.c.back() = std::max(1.0, b.c.back());
+  return b;
+}
+
+using PdfFn = std::function<double(vec3)>;  // solid-angle pdf of a direction above the surface
+
+// Integral of the solid-angle pdf over [c0, c1] x [p0, p1] (d omega = dc dphi): adaptive 4 x 4
+// Gauss-Legendre (at least two levels, then until two levels agree to 1e-4 relative or 1e-10
+// absolute). `guide` holds the (c, phi) of the pilot samples inside the cell, which steer the
+// quadrature to where the mass is: a cell is halved along each axis in which its points span less
+// than a quarter of it (the lobe of a hard set can be 1e-5 wide in c inside a bin that spans the
+// whole hemisphere, invisible to the rules of the bin), and split 2 x 2 while it holds more than
+// 32 of them. The pieces without points are then at least as far from the points as they are
+// wide, and the error-driven rule resolves what tail they hold. A lobe the pilot missed shows up
+// as well: either the quadrature finds it (expected counts where no sample falls) or the bin sums
+// stay below 1 (the tests check that they add up to 1).
+using Guide = std::vector<std::pair<float, float>>;
+inline vec3 binDirection(double c, double ph) {
+  double r = std::sqrt((1 - c) * (1 + c));
+  return vec3(float(r * std::cos(ph)), float(r * std::sin(ph)), float(c));
+}
+// 4 x 4 Gauss-Legendre over [a0, a1] x [b0, b1]; *fmax (optional) gets the largest value seen.
+inline double binRule(const PdfFn& pdf, double a0, double a1, double b0, double b1, double* fmax = nullptr) {
   static const double gx[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
   static const double gw[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
-  double c0 = std::sqrt(std::max(0.0, 1 - u1)), c1 = std::sqrt(std::max(0.0, 1 - u0));
-  auto rule = [&](double a0, double a1, double b0, double b1) {
-    double s = 0;
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j) {
-        double c = a0 + (a1 - a0) * 0.5 * (1 + gx[i]), ph = b0 + (b1 - b0) * 0.5 * (1 + gx[j]);
-        double r = std::sqrt((1 - c) * (1 + c));
-        if (c <= 0) continue;
-        vec3 w(float(r * std::cos(ph)), float(r * std::sin(ph)), float(c));
-        s += gw[i] * gw[j] * quadPdf(set, model, p, v, w);  // (pdf / c) * c
-      }
-    return s * 0.25 * (a1 - a0) * (b1 - b0);
-  };
-  double whole = rule(c0, c1, p0, p1);
+  double s = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      double c = a0 + (a1 - a0) * 0.5 * (1 + gx[i]), ph = b0 + (b1 - b0) * 0.5 * (1 + gx[j]);
+      if (c <= 0) continue;
+      double f = pdf(binDirection(c, ph));
+      if (fmax) *fmax = std::max(*fmax, f);
+      s += gw[i] * gw[j] * f;
+    }
+  return s * 0.25 * (a1 - a0) * (b1 - b0);
+}
+// Integral of the solid-angle pdf over [c0, c1] x [p0, p1] (d omega = dc dphi): adaptive 4 x 4
+// Gauss-Legendre. A cell is accepted when its rule and its four children's agree (1e-4 relative
+// or 1e-10 absolute) from the second level on, and when no point of its boundary (corners, edge
+// midpoints) is more than 4x above every Gauss point of its children: a lobe's tail that enters
+// the cell through an edge is invisible to the interior nodes, and two rules can agree on missing
+// it. `guide` holds the (c, phi) of the pilot samples inside the cell, which steer the quadrature
+// to where the mass is: a cell is halved along each axis in which its points span less than a
+// quarter of it (the lobe of a hard set can be 1e-5 wide in c inside a bin that spans the whole
+// hemisphere), and split 2 x 2 otherwise, while it holds more than 16 of them. A lobe the pilot missed shows
+// up as well: either the quadrature finds it (expected counts where no sample falls) or the bin
+// sums stay below 1 (the tests check that they add up to 1).
+inline double binIntegral(const PdfFn& pdf, double c0, double c1, double p0, double p1, const Guide& guide, int depth = 0,
+                          double whole = -1) {
+  if (whole < 0) whole = binRule(pdf, c0, c1, p0, p1);
   double cm = 0.5 * (c0 + c1), pm = 0.5 * (p0 + p1);
-  double parts = rule(c0, cm, p0, pm) + rule(cm, c1, p0, pm) + rule(c0, cm, pm, p1) + rule(cm, c1, pm, p1);
-  if (depth >= 6 || std::abs(whole - parts) <= 1e-4 * std::abs(parts) + 1e-9) return parts;
-  double um = 1 - cm * cm;  // the same split in u
-  return binIntegral(set, model, p, v, um, u1, p0, pm, depth + 1) + binIntegral(set, model, p, v, u0, um, p0, pm, depth + 1) +
-         binIntegral(set, model, p, v, um, u1, pm, p1, depth + 1) + binIntegral(set, model, p, v, u0, um, pm, p1, depth + 1);
+  bool sc = false, sp = false;
+  if (guide.size() > 16) {
+    float lc = 2, hc = -1, lp = 10, hp = -10;
+    for (const auto& pt : guide) {
+      lc = std::min(lc, pt.first); hc = std::max(hc, pt.first);
+      lp = std::min(lp, pt.second); hp = std::max(hp, pt.second);
+    }
+    sc = hc - lc < 0.25 * (c1 - c0);
+    sp = hp - lp < 0.25 * (p1 - p0);
+    if (!sc && !sp) sc = sp = true;
+  }
+  if (depth >= 40) return whole;
+  double q[4] = {-1, -1, -1, -1};  // the 2 x 2 children's rules when computed
+  if (!sc && !sp) {
+    double qmax = 0;
+    q[0] = binRule(pdf, c0, cm, p0, pm, &qmax); q[1] = binRule(pdf, cm, c1, p0, pm, &qmax);
+    q[2] = binRule(pdf, c0, cm, pm, p1, &qmax); q[3] = binRule(pdf, cm, c1, pm, p1, &qmax);
+    double parts = q[0] + q[1] + q[2] + q[3];
+    bool agree = std::abs(whole - parts) <= 1e-4 * std::abs(parts) + 1e-10;
+    if (depth >= 24) return parts;
+    if (depth >= 2 && agree) {
+      double bmax = 0;
+      for (double c : {c0, cm, c1})
+        for (double ph : {p0, pm, p1})
+          if (c > 0 && (c != cm || ph != pm)) bmax = std::max(bmax, pdf(binDirection(c, ph)));
+      if (bmax <= 4 * qmax || bmax * (c1 - c0) * (p1 - p0) < 1e-12) return parts;
+    }
+    sc = sp = true;
+  }
+  // Children (halved along the chosen axes) with their points.
+  double ca[2] = {c0, sc ? cm : c1}, cb[2] = {sc ? cm : c1, c1}, pa[2] = {p0, sp ? pm : p1}, pb[2] = {sp ? pm : p1, p1};
+  int nc = sc ? 2 : 1, np = sp ? 2 : 1;
+  Guide g[4];
+  for (const auto& pt : guide) g[(sc && pt.first >= cm ? 1 : 0) + (sp && pt.second >= pm ? 2 : 0)].push_back(pt);
+  double sum = 0;
+  for (int i = 0; i < nc; ++i)
+    for (int j = 0; j < np; ++j)
+      sum += binIntegral(pdf, ca[i], cb[i], pa[j], pb[j], g[i + 2 * j], depth + 1, (sc && sp) ? q[i + 2 * j] : -1);
+  return sum;
+}
+
+// Probabilities of the bins; `guide` (optional): pilot samples that steer the quadrature. Two
+// threads; `threadContext` (optional) is called on each and holds what the pdf needs there (the
+// quadtree's QuadHostScope) for as long as the thread runs.
+using ThreadContext = std::function<std::shared_ptr<void>()>;
+inline std::vector<double> binProbabilities(const PdfFn& pdf, const Binning& b, const std::vector<vec4>& guide = {},
+                                            const ThreadContext& threadContext = {}) {
+  std::vector<Guide> perBin(b.size());
+  for (const vec4& s : guide) {
+    if (s.w <= 0) continue;
+    std::size_t k = b.bin(vec3(s));
+    std::size_t i = 0, base = 0;
+    while (base + b.phi[i].size() - 1 <= k) base += b.phi[i++].size() - 1;
+    double ph = std::atan2(double(s.y), double(s.x));
+    while (ph < b.phi[i].front()) ph += 2 * M_PI;
+    while (ph >= b.phi[i].front() + 2 * M_PI) ph -= 2 * M_PI;
+    perBin[k].push_back({s.z, float(ph)});
+  }
+  struct Cell { double c0, c1, p0, p1; };
+  std::vector<Cell> cells;
+  for (std::size_t i = 0; i + 1 < b.c.size(); ++i)
+    for (std::size_t j = 0; j + 1 < b.phi[i].size(); ++j) cells.push_back({b.c[i], b.c[i + 1], b.phi[i][j], b.phi[i][j + 1]});
+  std::vector<double> e(cells.size());
+  std::atomic<std::size_t> next{0};
+  auto work = [&]() {
+    std::shared_ptr<void> ctx = threadContext ? threadContext() : nullptr;
+    for (std::size_t k; (k = next.fetch_add(1)) < cells.size();)
+      e[k] = binIntegral(pdf, cells[k].c0, cells[k].c1, cells[k].p0, cells[k].p1, perBin[k]);
+  };
+  std::thread helper(work);
+  work();
+  helper.join();
+  return e;
 }
 
 struct Chi2Result {
   double pValue = 1, chi2 = 0;
   int dof = 0;
-  double expectedTotal = 0;  // integral of the pdf over the disc (should be 1)
-  std::string dump;          // histograms (observed / expected) for failures
+  double expectedTotal = 0;  // integral of the pdf over the hemisphere (1, or 1 - failure rate)
+  double failedObserved = 0;
+  std::string dump;          // observed / expected per bin, for failures
 };
 
-// Samples must come from the same set/model/params/v; failed samples (pdf 0) count as outside.
-inline Chi2Result chiSquare(std::uint32_t set, std::uint32_t model, const BrdfParams& p, vec3 v,
-                            const std::vector<vec4>& samples) {
-  std::vector<double> obs(kRings * kSectors, 0), exp(kRings * kSectors, 0);
+// Samples (direction, pdf; pdf 0 = failed) against the bin probabilities `prob` of `bins`.
+inline Chi2Result chiSquare(const Binning& bins, const std::vector<double>& prob, const std::vector<vec4>& samples) {
+  const std::size_t nb = bins.size();
+  std::vector<double> obs(nb + 1, 0), exp(nb + 1, 0);
   double n = double(samples.size());
-  for (const vec4& s : samples) {
-    if (s.w <= 0) continue;
-    double u = std::min(0.999999999, double(s.x) * s.x + double(s.y) * s.y);
-    double ph = std::atan2(double(s.y), double(s.x));
-    if (ph < 0) ph += 2 * M_PI;
-    int i = std::min(kRings - 1, int(u * kRings)), j = std::min(kSectors - 1, int(ph / (2 * M_PI) * kSectors));
-    obs[i * kSectors + j] += 1;
-  }
   Chi2Result r;
-  for (int i = 0; i < kRings; ++i)
-    for (int j = 0; j < kSectors; ++j) {
-      double e = binIntegral(set, model, p, v, double(i) / kRings, double(i + 1) / kRings, 2 * M_PI * j / kSectors,
-                             2 * M_PI * (j + 1) / kSectors);
-      exp[i * kSectors + j] = e * n;
-      r.expectedTotal += e;
-    }
-  // Pool the bins below 5 expected.
+  for (const vec4& s : samples) {
+    if (s.w <= 0) { obs[nb] += 1; continue; }
+    obs[bins.bin(vec3(s))] += 1;
+  }
+  for (std::size_t k = 0; k < nb; ++k) {
+    exp[k] = prob[k] * n;
+    r.expectedTotal += prob[k];
+  }
+  exp[nb] = std::max(0.0, 1 - r.expectedTotal) * n;
+  r.failedObserved = obs[nb];
   double pooledO = 0, pooledE = 0;
-  int bins = 0;
-  for (std::size_t k = 0; k < obs.size(); ++k) {
-    if (exp[k] < 5) {
-      pooledO += obs[k];
-      pooledE += exp[k];
-      continue;
-    }
+  int used = 0;
+  for (std::size_t k = 0; k <= nb; ++k) {
+    if (exp[k] < 5) { pooledO += obs[k]; pooledE += exp[k]; continue; }
     r.chi2 += (obs[k] - exp[k]) * (obs[k] - exp[k]) / exp[k];
-    ++bins;
+    ++used;
   }
   if (pooledE >= 5) {
     r.chi2 += (pooledO - pooledE) * (pooledO - pooledE) / pooledE;
-    ++bins;
+    ++used;
   } else if (pooledO > 20) {
     r.chi2 = 1e30;  // many samples where the pdf says (almost) none
   }
-  r.dof = std::max(1, bins - 1);
+  r.dof = std::max(1, used - 1);
   r.pValue = gammaQ(0.5 * r.dof, 0.5 * r.chi2);
-  char line[64];
-  r.dump = "observed/expected per bin (ring r^2 rows x sector columns):\n";
-  for (int i = 0; i < kRings; ++i) {
-    for (int j = 0; j < kSectors; ++j) {
-      std::snprintf(line, sizeof line, "%.0f/%.1f ", obs[i * kSectors + j], exp[i * kSectors + j]);
+  char line[96];
+  r.dump = "observed/expected per bin (rings in cos theta: edges, then sectors):\n";
+  std::size_t k = 0;
+  for (std::size_t i = 0; i + 1 < bins.c.size(); ++i) {
+    std::snprintf(line, sizeof line, "[%.5f, %.5f]: ", bins.c[i], bins.c[i + 1]);
+    r.dump += line;
+    for (std::size_t j = 0; j + 1 < bins.phi[i].size(); ++j, ++k) {
+      std::snprintf(line, sizeof line, "%.0f/%.1f ", obs[k], exp[k]);
       r.dump += line;
     }
     r.dump += "\n";
   }
+  std::snprintf(line, sizeof line, "failed %.0f/%.1f\n", obs[nb], exp[nb]);
+  r.dump += line;
   return r;
+}
+
+// The quadtree sampler's test for one case: pilot bins from `pilot`, expected counts from quadPdf.
+inline Chi2Result quadChiSquare(const quadtree::SamplerTables& t, std::uint32_t set, std::uint32_t model, const BrdfParams& p,
+                                vec3 v, const std::vector<vec4>& pilot, const std::vector<vec4>& samples) {
+  Binning bins = quantileBinning(pilot, 16, 32);
+  std::vector<double> prob = binProbabilities([&](vec3 w) { return double(quadPdf(set, model, p, v, w)); }, bins, pilot,
+                                              [&]() { return std::make_shared<quadtree::QuadHostScope>(t); });
+  return chiSquare(bins, prob, samples);
 }
 
 inline vec3 knownDirection(const Case& c) {

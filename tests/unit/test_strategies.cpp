@@ -1,9 +1,10 @@
 // test_strategies.cpp: the `analytic` and `tabulated` BSDF sampling strategies on the CPU (the shared
 // code of shaders/shared/analytic_sampling.h and tabulated.h):
-//   - chi-square goodness of fit of the samples against the strategy's own pdf (equal-area disc
-//     bins as tests/unit/test_quadtree_chi2.h, plus one bin for failed samples: a lobe sample below
-//     the surface fails, and the pdf's missing mass must match the failure rate), fixed seed,
-//     significance 0.01 with Bonferroni over the cases;
+//   - chi-square goodness of fit of the samples against the strategy's own pdf (tests/unit/
+//     test_quadtree_chi2.h: analytic with equal-probability bins from an independent pilot run,
+//     tabulated with the fixed equal-area bins whose probabilities are exact for its cells; one
+//     more bin for failed samples: a lobe sample below the surface fails, and the pdf's missing
+//     mass must match the failure rate), fixed seed, significance 0.01 with Bonferroni over the cases;
 //   - unbiasedness: for every strategy the mean of luminance(f) cos / pdf (failures count 0) agrees
 //     with directionalAlbedo within 5 standard errors (sample variance; > the Bonferroni z of 0.01
 //     over the cases) plus 2e-4 relative (the quadrature's and float's error).
@@ -27,8 +28,7 @@ using namespace nusselt::shared;
 
 namespace {
 
-using qttest::kRings;
-using qttest::kSectors;
+constexpr int kRings = 16, kSectors = 32;
 
 // The chi-square suite's case (model, set, angles) with the accessors this file uses.
 struct SCase : qttest::Case {
@@ -37,117 +37,6 @@ struct SCase : qttest::Case {
   BrdfParams params() const { return qttest::caseParams(*this); }
   std::uint32_t id() const { return findModel(model)->id; }
 };
-
-using PdfFn = std::function<double(vec3)>;  // solid-angle pdf of a direction above the surface
-
-// Integral of pdf over one disc bin [u0, u1] x [p0, p1] (u = r^2), adaptive 4 x 4 Gauss-Legendre in
-// (c = cos theta, phi) (dA = c dc dphi, pdf_A = pdf / c). Cells near a peak direction (lobe axes:
-// narrow lobes that a 4 x 4 rule would miss) are split down to depth 12 whatever the error estimate.
-double binIntegral(const PdfFn& pdf, const std::vector<vec3>& peaks, double c0, double c1, double p0, double p1,
-                   int depth = 0) {
-  static const double gx[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
-  static const double gw[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538};
-  auto rule = [&](double a0, double a1, double b0, double b1) {
-    double s = 0;
-    for (int i = 0; i < 4; ++i)
-      for (int j = 0; j < 4; ++j) {
-        double c = a0 + (a1 - a0) * 0.5 * (1 + gx[i]), ph = b0 + (b1 - b0) * 0.5 * (1 + gx[j]);
-        if (c <= 0) continue;
-        double r = std::sqrt((1 - c) * (1 + c));
-        s += gw[i] * gw[j] * pdf(vec3(float(r * std::cos(ph)), float(r * std::sin(ph)), float(c)));
-      }
-    return s * 0.25 * (a1 - a0) * (b1 - b0);
-  };
-  bool nearPeak = false;
-  int peakDepth = 12;
-  for (const vec3& pk : peaks) {
-    double dc = c1 - c0, dp = p1 - p0;
-    if (pk.z < c0 - dc || pk.z > c1 + dc) continue;
-    if (pk.x * pk.x + pk.y * pk.y < 1e-12) {  // at the pole every azimuth touches it: fewer forced levels
-      nearPeak = true;
-      peakDepth = 8;
-      break;
-    }
-    double ph = std::atan2(double(pk.y), double(pk.x));
-    if (ph < 0) ph += 2 * M_PI;
-    for (double off : {-2 * M_PI, 0.0, 2 * M_PI})
-      if (ph + off >= p0 - dp && ph + off <= p1 + dp) nearPeak = true;
-  }
-  double whole = rule(c0, c1, p0, p1);
-  double cm = 0.5 * (c0 + c1), pm = 0.5 * (p0 + p1);
-  double parts = rule(c0, cm, p0, pm) + rule(cm, c1, p0, pm) + rule(c0, cm, pm, p1) + rule(cm, c1, pm, p1);
-  bool converged = std::abs(whole - parts) <= 1e-4 * std::abs(parts) + 1e-10;
-  if ((depth >= 6 || converged) && !(nearPeak && depth < peakDepth)) return parts;
-  return binIntegral(pdf, peaks, c0, cm, p0, pm, depth + 1) + binIntegral(pdf, peaks, cm, c1, p0, pm, depth + 1) +
-         binIntegral(pdf, peaks, c0, cm, pm, p1, depth + 1) + binIntegral(pdf, peaks, cm, c1, pm, p1, depth + 1);
-}
-
-// Expected probability of each disc bin (ring i, sector j at i * kSectors + j) by quadrature.
-std::vector<double> binProbabilities(const PdfFn& pdf, const std::vector<vec3>& peaks) {
-  std::vector<double> e(kRings * kSectors);
-  for (int i = 0; i < kRings; ++i)
-    for (int j = 0; j < kSectors; ++j) {
-      double u0 = double(i) / kRings, u1 = double(i + 1) / kRings;
-      e[i * kSectors + j] = binIntegral(pdf, peaks, std::sqrt(std::max(0.0, 1 - u1)), std::sqrt(1 - u0),
-                                        2 * M_PI * j / kSectors, 2 * M_PI * (j + 1) / kSectors);
-    }
-  return e;
-}
-
-struct Chi2 {
-  double pValue = 1, chi2 = 0, total = 0, failedObserved = 0;
-  int dof = 0;
-  std::string dump;
-};
-
-// Samples (w, pdf; pdf 0 = failed) against bin probabilities; the failed samples form one more bin
-// with probability 1 - sum (clamped at 0). Bins below 5 expected are pooled.
-Chi2 chiSquare(const std::vector<double>& prob, const std::vector<vec4>& samples) {
-  const int nb = kRings * kSectors;
-  std::vector<double> obs(nb + 1, 0), exp(nb + 1, 0);
-  double n = double(samples.size());
-  Chi2 r;
-  for (const vec4& s : samples) {
-    if (s.w <= 0) { obs[nb] += 1; continue; }
-    double u = std::min(0.999999999, double(s.x) * s.x + double(s.y) * s.y);
-    double ph = std::atan2(double(s.y), double(s.x));
-    if (ph < 0) ph += 2 * M_PI;
-    int i = std::min(kRings - 1, int(u * kRings)), j = std::min(kSectors - 1, int(ph / (2 * M_PI) * kSectors));
-    obs[i * kSectors + j] += 1;
-  }
-  for (int k = 0; k < nb; ++k) {
-    exp[k] = prob[k] * n;
-    r.total += prob[k];
-  }
-  exp[nb] = std::max(0.0, 1 - r.total) * n;
-  r.failedObserved = obs[nb];
-  double pooledO = 0, pooledE = 0;
-  int bins = 0;
-  for (int k = 0; k <= nb; ++k) {
-    if (exp[k] < 5) { pooledO += obs[k]; pooledE += exp[k]; continue; }
-    r.chi2 += (obs[k] - exp[k]) * (obs[k] - exp[k]) / exp[k];
-    ++bins;
-  }
-  if (pooledE >= 5) {
-    r.chi2 += (pooledO - pooledE) * (pooledO - pooledE) / pooledE;
-    ++bins;
-  } else if (pooledO > 20) {
-    r.chi2 = 1e30;
-  }
-  r.dof = std::max(1, bins - 1);
-  r.pValue = qttest::gammaQ(0.5 * r.dof, 0.5 * r.chi2);
-  char line[64];
-  for (int i = 0; i < kRings; ++i) {
-    for (int j = 0; j < kSectors; ++j) {
-      std::snprintf(line, sizeof line, "%.0f/%.1f ", obs[i * kSectors + j], exp[i * kSectors + j]);
-      r.dump += line;
-    }
-    r.dump += "\n";
-  }
-  std::snprintf(line, sizeof line, "failed %.0f/%.1f\n", obs[nb], exp[nb]);
-  r.dump += line;
-  return r;
-}
 
 // Exact bin probabilities of a tabulated table: the disc density is constant on the table's cells
 // (rectangles in (u, phi), as the bins are), so each bin is a sum of overlaps.
@@ -188,7 +77,11 @@ std::vector<double> tabBinProbabilities(const sampling::TabulatedTables& t, std:
           }
       }
     }
-  return e;
+  // Rings above are in u = r^2; qttest::uniformBinning orders them by ascending cos theta.
+  std::vector<double> byC(e.size());
+  for (int ri = 0; ri < kRings; ++ri)
+    for (int sj = 0; sj < kSectors; ++sj) byC[(kRings - 1 - ri) * kSectors + sj] = e[ri * kSectors + sj];
+  return byC;
 }
 
 // alpha / cases, and the run's bookkeeping.
@@ -211,22 +104,8 @@ std::vector<SCase> analyticCases() {
   return cases;
 }
 
-std::vector<vec3> analyticPeaks(const SCase& c) {
-  vec3 v = c.v();
-  std::vector<vec3> peaks{brdfReflectZ(v)};
-  if (c.id() == MODEL_LAFORTUNE) {
-    BrdfParams p = c.params();
-    uint count = uint(brdfParam(p, LAFORTUNE_LOBE_COUNT) + 0.5f);
-    for (uint j = 0; j < count; ++j) {
-      vec3 axis;
-      float n, lw;
-      if (analyticLafortuneLobe(p, j, v, axis, n, lw) && axis.z > 0) peaks.push_back(axis);
-    }
-  }
-  return peaks;
-}
-
 constexpr std::uint32_t kChi2Samples = 100000;
+constexpr std::uint32_t kPilot = 50000;  // the analytic test's bins: quantiles of an independent run
 constexpr std::uint32_t kSeed = 12345;
 
 TEST(Strategies, AnalyticChiSquare) {
@@ -239,16 +118,19 @@ TEST(Strategies, AnalyticChiSquare) {
     vec3 v = c.v();
     std::uint32_t id = c.id();
     quadtree::SampleBatch b = quadtree::sampleCpuStrategy(SAMPLER_ANALYTIC, nullptr, 0, id, p, v, kChi2Samples, kSeed, 1);
-    std::vector<double> prob = binProbabilities([&](vec3 w) { return double(analyticPdf(id, p, v, w)); }, analyticPeaks(c));
-    Chi2 r = chiSquare(prob, b.wPdf);
+    quadtree::SampleBatch pilot = quadtree::sampleCpuStrategy(SAMPLER_ANALYTIC, nullptr, 0, id, p, v, kPilot, kSeed + 1, 1);
+    qttest::Binning bins = qttest::quantileBinning(pilot.wPdf, kRings, kSectors);
+    std::vector<double> prob =
+        qttest::binProbabilities([&](vec3 w) { return double(analyticPdf(id, p, v, w)); }, bins, pilot.wPdf);
+    qttest::Chi2Result r = qttest::chiSquare(bins, prob, b.wPdf);
     // The returned pdf is the strategy's pdf at the returned direction.
     double worst = 0;
     for (const vec4& s : b.wPdf)
       if (s.w > 0) worst = std::max(worst, std::abs(double(analyticPdf(id, p, v, vec3(s))) / s.w - 1));
     std::printf("analytic %-42s p=%.3g chi2=%.1f dof=%d mass=%.5f failed=%.0f\n", c.name().c_str(), r.pValue, r.chi2,
-                r.dof, r.total, r.failedObserved);
+                r.dof, r.expectedTotal, r.failedObserved);
     EXPECT_LT(worst, 1e-5) << c.name();
-    EXPECT_LE(r.total, 1.0 + 2e-3) << c.name() << ": the pdf integrates to more than 1";
+    EXPECT_LE(r.expectedTotal, 1.0 + 2e-3) << c.name() << ": the pdf integrates to more than 1";
     if (r.pValue < mx.cellAlpha()) ADD_FAILURE() << c.name() << ": p = " << r.pValue << "\n" << r.dump;
   }
   std::printf("analytic chi-square: %zu cases, alpha %.3g per case, %.1f s\n", cases.size(), mx.cellAlpha(),
@@ -294,13 +176,13 @@ TEST(Strategies, TabulatedChiSquare) {
     BrdfParams p = c.params();
     vec3 v = c.v();
     quadtree::SampleBatch b = quadtree::sampleCpuStrategy(SAMPLER_TABULATED, &t, 0, c.id(), p, v, kChi2Samples, kSeed, 1);
-    Chi2 r = chiSquare(tabBinProbabilities(t, 0, v), b.wPdf);
+    qttest::Chi2Result r = qttest::chiSquare(qttest::uniformBinning(kRings, kSectors), tabBinProbabilities(t, 0, v), b.wPdf);
     double worst = 0;
     for (const vec4& s : b.wPdf)
       if (s.w > 0) worst = std::max(worst, std::abs(double(tabPdf(0, v, vec3(s))) / s.w - 1));
     std::printf("tabulated %-42s p=%.3g chi2=%.1f dof=%d mass=%.6f failed=%.0f pdf-lookup mismatch %.2g\n",
-                c.name().c_str(), r.pValue, r.chi2, r.dof, r.total, r.failedObserved, worst);
-    EXPECT_NEAR(r.total, 1.0, 1e-5) << c.name();
+                c.name().c_str(), r.pValue, r.chi2, r.dof, r.expectedTotal, r.failedObserved, worst);
+    EXPECT_NEAR(r.expectedTotal, 1.0, 1e-5) << c.name();
     if (r.pValue < mx.cellAlpha()) ADD_FAILURE() << c.name() << ": p = " << r.pValue << "\n" << r.dump;
   }
   std::printf("tabulated chi-square: %zu cases, alpha %.3g per case, %.1f s\n", cases.size(), mx.cellAlpha(),
