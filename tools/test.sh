@@ -20,4 +20,4 @@ if [ "${SKIP_FUZZ:-0}" != 1 ]; then
 fi
 # Last, so that its summary ("100% tests passed, 0 tests failed out of N") closes the output.
 echo "== main suite (ctest)"
-ctest --test-dir build --output-on-failure
+ctest --test-dir build --output-on-failure -j "$(nproc)"

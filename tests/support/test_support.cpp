@@ -4,11 +4,15 @@
 #include <cstdlib>
 #include <sstream>
 
+#include <gtest/gtest.h>
+
 #include "scene/gltf_loader.h"
 
 namespace nusselt::test {
 
 namespace {
+vk::Context* g_context = nullptr;  // set once the shared context exists
+
 struct ContextHolder {
   vk::Context ctx;
   ContextHolder() {
@@ -16,9 +20,29 @@ struct ContextHolder {
     const char* v = std::getenv("NUSSELT_VALIDATION");
     o.validation = v && *v && std::string(v) != "0";
     vk::createContext(ctx, o);
+    g_context = &ctx;
   }
-  ~ContextHolder() { vk::destroyContext(ctx); }
+  ~ContextHolder() {
+    g_context = nullptr;
+    vk::destroyContext(ctx);
+  }
 };
+
+// Any validation-layer message during a test fails that test, whether or not the test checks
+// validationMessages() itself (ctest runs the GPU and render tests with NUSSELT_VALIDATION=1).
+class ValidationListener : public ::testing::EmptyTestEventListener {
+  std::uint64_t m_before = 0;
+  static std::uint64_t count() { return g_context ? g_context->validationMessages.load() : 0; }
+  void OnTestStart(const ::testing::TestInfo&) override { m_before = count(); }
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    std::uint64_t n = count() - m_before;
+    if (n) ADD_FAILURE() << info.test_suite_name() << "." << info.name() << ": " << n << " Vulkan validation message(s)";
+  }
+};
+const bool g_listener = [] {
+  ::testing::UnitTest::GetInstance()->listeners().Append(new ValidationListener);
+  return true;
+}();
 }  // namespace
 
 vk::Context& context() {
