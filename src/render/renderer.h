@@ -44,8 +44,8 @@ struct RenderSettings {
   ComponentSelection components = ComponentSelection::Albedo;  // combined materials only
   // The quadtree sampler's table counts (quadtree::QuadtreeSettings; the paper's 90 and 16 by
   // default; phi only for anisotropic sets). Fewer tables build faster (the hard-case tests use
-  // 18 x 4 for the anisotropic hard sets, whose 1440 trees take minutes) at the cost of a coarser
-  // grid in the outgoing direction: a looser fit between tables, more variance.
+  // 90 x 4 for the anisotropic hard sets) at the cost of a coarser grid in the outgoing direction:
+  // a looser fit between tables, more variance (never bias).
   std::uint32_t samplerThetaTables = 90;
   std::uint32_t samplerPhiTables = 16;
   // Sample indices of this render start here (`--spp-offset`): a frame can be split across
