@@ -503,8 +503,8 @@ class HardSetsOfTheCatalogue : public ::testing::TestWithParam<HardCase> {};
 
 // Tables: the renderer's default 90 theta tables; the anisotropic hard sets (ward ax != ay,
 // ashikhmin_shirley nu != nv, schlick p < 1, poulin_fournier) with 4 phi tables instead of 16 (360
-// trees instead of 1440: poulin_fournier's took 70 s of this test's 92 s). The sampler is exact
-// with any table count; the chi-square suite tests the default 16.
+// trees instead of 1440: at 16, poulin_fournier's case took 92 s in a full ctest run). The sampler
+// is exact with any table count; the chi-square suites test the default 16.
 const HardCase kHardCases[] = {
     {"lambert"}, {"phong_specular"}, {"phong"}, {"lewis"}, {"blinn"}, {"torrance_sparrow"}, {"ward", 90, 4},
     {"ashikhmin_shirley", 90, 4}, {"lafortune"}, {"minnaert"}, {"oren_nayar"}, {"schlick", 90, 4}, {"strauss"},
