@@ -1,5 +1,6 @@
 #include "cli/cli_common.h"
 
+#include <cstdio>
 #include <unistd.h>
 
 #include <csignal>
@@ -41,6 +42,16 @@ Scene loadSceneOrDefault(const std::string& path, const std::string& camera) {
   opts.cameraName = camera;
   if (path.empty()) return loadSceneFromMemory(kDefaultSceneBytes, kDefaultSceneSize, "default scene (cornell-box.glb)", opts);
   return loadScene(path, opts);
+}
+
+void printSceneWarnings(const Scene& scene, bool quiet) {
+  if (quiet) return;
+  for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  if (scene.droppedTriangles)
+    std::fprintf(stderr,
+                 "warning: %s: dropped %llu degenerate triangles (zero area, non-finite vertices or coordinates "
+                 "beyond 1e15)\n",
+                 scene.sourcePath.c_str(), static_cast<unsigned long long>(scene.droppedTriangles));
 }
 
 }  // namespace nusselt

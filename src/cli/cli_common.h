@@ -23,4 +23,7 @@ void checkOutputPath(const std::string& path, const std::string& option);
 // The scene at `path`, or the built-in Cornell box when `path` is empty.
 Scene loadSceneOrDefault(const std::string& path, const std::string& camera);
 
+// The loader's warnings on stderr (unless quiet), with the count of dropped triangles.
+void printSceneWarnings(const Scene& scene, bool quiet);
+
 }  // namespace nusselt

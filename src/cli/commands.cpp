@@ -26,13 +26,6 @@
 namespace nusselt {
 namespace {
 
-void printSceneWarnings(const Scene& scene, bool quiet) {
-  if (quiet) return;
-  for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-  if (scene.droppedTriangles)
-    std::fprintf(stderr, "warning: %s: dropped %llu degenerate triangles (zero area or non-finite vertices)\n",
-                 scene.sourcePath.c_str(), static_cast<unsigned long long>(scene.droppedTriangles));
-}
 
 struct RenderArgs {
   std::string scene;

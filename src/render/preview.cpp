@@ -699,12 +699,7 @@ int Preview::run() {
   if (!exts) throw Error("no Vulkan surface extension for this display (" + glfwErrorText + "); use `nusselt render`");
 
   m_scene = loadSceneOrDefault(a.scene, a.camera);
-  if (!a.quiet) {
-    for (const std::string& w : m_scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-    if (m_scene.droppedTriangles)
-      std::fprintf(stderr, "warning: %s: dropped %llu degenerate triangles\n", m_scene.sourcePath.c_str(),
-                   static_cast<unsigned long long>(m_scene.droppedTriangles));
-  }
+  printSceneWarnings(m_scene, a.quiet);
   m_settings.seed = a.seed;
   m_settings.maxDepth = a.maxDepth;
   m_settings.lighting = parseLighting(a.lighting);

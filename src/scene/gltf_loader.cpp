@@ -54,6 +54,10 @@ constexpr std::uint64_t kMaxFileBytes = 1ull << 30;
 constexpr std::uint64_t kMaxTriangles = 1ull << 24;
 // Deeper JSON is refused: tinygltf converts extension/extras values recursively.
 constexpr int kMaxJsonDepth = 64;
+// Triangles with a vertex coordinate beyond this (after the node transforms) are dropped like
+// non-finite ones: the renderer's float arithmetic (ray offsets, the default view's distance)
+// would overflow near the float range (fuzz_gltf found a camera at infinity from 3e38).
+constexpr double kMaxCoordinate = 1e15;
 
 const char* const kSupportedExtensions[] = {"NUSSELT_brdf", "KHR_lights_punctual",
                                             "KHR_materials_emissive_strength"};
@@ -950,8 +954,10 @@ class Converter {
       glm::vec3 p[3];
       bool finite = true;
       for (int k = 0; k < 3; ++k) {
-        p[k] = glm::vec3(world * glm::dvec4(glm::dvec3(readVec3(pos, c[k])), 1.0));
-        finite = finite && std::isfinite(p[k].x) && std::isfinite(p[k].y) && std::isfinite(p[k].z);
+        glm::dvec3 q = glm::dvec3(world * glm::dvec4(glm::dvec3(readVec3(pos, c[k])), 1.0));
+        p[k] = glm::vec3(q);
+        finite = finite && std::abs(q.x) <= kMaxCoordinate && std::abs(q.y) <= kMaxCoordinate &&
+                 std::abs(q.z) <= kMaxCoordinate;  // false for NaN too
       }
       // In float, as the renderer computes it: a zero cross product has no geometric normal.
       glm::vec3 g = glm::cross(p[1] - p[0], p[2] - p[0]);

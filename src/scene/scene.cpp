@@ -29,6 +29,9 @@ Camera frameScene(const Scene& scene) {
   // sides, which is acceptable for a preview view.
   double distance = radius / std::sin(0.5 * static_cast<double>(camera.yfov));
   camera.position = glm::vec3(centre + glm::dvec3(0.0, 0.0, distance));
+  // Loaded scenes keep their coordinates within 1e15; a scene built in code might not.
+  if (!std::isfinite(camera.position.x) || !std::isfinite(camera.position.y) || !std::isfinite(camera.position.z))
+    camera.position = glm::vec3(0.0f, 0.0f, float(1.0 / std::sin(0.5 * static_cast<double>(camera.yfov))));
   return camera;
 }
 

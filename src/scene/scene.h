@@ -69,7 +69,7 @@ struct Scene {
   Camera camera;
   bool hasCamera = false;  // false: the renderer frames the scene with a default view
   glm::vec3 background{0.0f};  // radiance of escaping rays
-  std::uint64_t droppedTriangles = 0;  // zero-area or non-finite triangles that were skipped
+  std::uint64_t droppedTriangles = 0;  // skipped: zero area, non-finite vertex, or a coordinate beyond 1e15
   std::vector<std::string> warnings;   // one line each, printed once by the caller
 
   std::size_t triangleCount() const { return triangleMaterial.size(); }

@@ -761,3 +761,15 @@ TEST(GltfLoader, RegressionsFoundByReview) {
     EXPECT_NE(msg.find(c.field), std::string::npos) << c.file << ": " << msg;
   }
 }
+
+// Found by fuzz_gltf (a long run): a triangle with a coordinate near the float maximum framed by
+// the default view put the camera at infinity. Coordinates beyond 1e15 now drop their triangle
+// (counted), and the default view of what is left is finite.
+TEST(GltfLoader, RegressionHugeCoordinatesDropTheirTriangles) {
+  const std::string path = std::string(NUSSELT_SOURCE_DIR) + "/tests/fuzz/corpus/gltf/regress_camera_at_infinity.glb";
+  nusselt::Scene s = nusselt::loadScene(path);
+  EXPECT_GT(s.droppedTriangles, 0u);
+  for (const glm::vec3& p : s.positions)
+    for (int k = 0; k < 3; ++k) EXPECT_LE(std::abs(p[k]), 1e15f);
+  EXPECT_TRUE(std::isfinite(s.camera.position.x) && std::isfinite(s.camera.position.y) && std::isfinite(s.camera.position.z));
+}
