@@ -24,7 +24,8 @@ using namespace shared;
 namespace {
 
 // Bump when the tree format or the build algorithm changes: old cache entries become stale.
-constexpr std::uint32_t kFormatVersion = 6;  // 6: polar rim annulus, half disc, exponential envelopes, 48-byte leaves
+constexpr std::uint32_t kFormatVersion = 7;  // 6: polar rim annulus, half disc, exponential envelopes, 48-byte leaves;
+                                             // 7: leaves below 1/n_max polished from a lattice
 constexpr char kMagic[8] = {'N', 'U', 'S', 'Q', 'T', 'R', 'E', 'E'};
 
 std::uint64_t fnv1a(const void* data, std::size_t n, std::uint64_t h = 1469598103934665603ull) {
