@@ -623,7 +623,7 @@ std::string reportMarkdown(const ErrorArgs& a, const PointConfig& pc, const std:
        "exact sampler.\n"
        "- **Cost of rejection on lavapipe**: the quadtree draws from a proposal and accepts with f / bound, so each "
        "sample evaluates f once or more, walks the tree and loops; on lavapipe every branch body of the loop runs "
-       "for each group of 8 lanes, so the slowest lane sets the pace (docs: ../shared/reference/lavapipe.md). The "
+       "for each group of 8 lanes, so the slowest lane sets the pace (README.md, Design). The "
        "cost per sample above is the measured consequence. On a real GPU the divergence costs less, and the "
        "evaluation of f dominates for expensive models, where the quadtree's variance advantage matters most.\n"
        "- **Where the quadtree should win**: models without an exact sampler (strauss, oren_nayar, minnaert, "
