@@ -236,6 +236,36 @@ struct Frame {
   }
 };
 
+// The point of a leaf's proposal domain at proposal coordinates (t1, t2), as the samplers map it
+// (shaders/shared/quadtree.h): square: (x, y) over [a0, a1] x [b0, b1]; polar: c^2 over [a0^2, a1^2],
+// phi / pi over [b0, b1]; a polar cut keeps only points inside the square cell [cx0, cx1] x [cy0, cy1].
+// False where the sampler discards the point (outside the disc or the cell, at the horizon).
+bool proposalPoint(int kind, double a0, double a1, double b0, double b1, double cx0, double cx1, double cy0,
+                   double cy1, double t1, double t2, double& x, double& y, double& c) {
+  if (kind == QT_PROPOSAL_SQUARE) {
+    x = a0 + t1 * (a1 - a0);
+    y = b0 + t2 * (b1 - b0);
+    double r2 = x * x + y * y;
+    if (r2 >= 1) return false;
+    c = std::sqrt(1 - r2);
+    return true;
+  }
+  double u0 = a0 * a0, u1 = a1 * a1;
+  c = std::sqrt(u0 + t1 * (u1 - u0));
+  if (!(float(c) > 0)) return false;
+  double ph = M_PI * (b0 + t2 * (b1 - b0)), rr = std::sqrt((1 - c) * (1 + c));
+  x = rr * std::cos(ph);
+  y = rr * std::sin(ph);
+  return !(kind == QT_PROPOSAL_POLAR_CUT && (x < cx0 || x > cx1 || y < cy0 || y > cy1));
+}
+
+// A leaf's envelope A exp(k1 (t1 - 1/2) + k2 (t2 - 1/2)) + B c^-s.
+double envelopeAt(double A, double k1, double k2, double B, double s, double t1, double t2, double c) {
+  double e = A * std::exp(k1 * (t1 - 0.5) + k2 * (t2 - 0.5));
+  if (B > 0) e += B * std::pow(c, -s);
+  return e;
+}
+
 double expMass(double k) { return k == 0 ? 1.0 : 2.0 * std::sinh(0.5 * k) / k; }
 
 struct Envelope {
@@ -792,30 +822,13 @@ Envelope Builder::fit(const Cell& cell, const Frame& fr, const CellResult& all, 
 // the grid and Gauss points can hide.
 void Builder::polish(const Cell& cell, const Frame& fr, CellResult& all, Envelope& env, int lattice) {
   const double s = m_traits.rimExponent;
-  auto envAt = [&](double t1, double t2, double c) {
-    double e = env.A * std::exp(env.k1 * (t1 - 0.5) + env.k2 * (t2 - 0.5));
-    if (env.B > 0) e += env.B * std::pow(c, -s);
-    return e;
-  };
+  auto envAt = [&](double t1, double t2, double c) { return envelopeAt(env.A, env.k1, env.k2, env.B, s, t1, t2, c); };
   // f / e at proposal coordinates (t1, t2); -1 outside the leaf's region.
   auto ratioAt = [&](double t1, double t2) {
-    if (!(t1 >= 0 && t1 <= 1 && t2 >= 0 && t2 <= 1)) return -1.0;
     double x, y, c;
-    if (fr.kind == QT_PROPOSAL_SQUARE) {
-      x = fr.a0 + t1 * (fr.a1 - fr.a0);
-      y = fr.b0 + t2 * (fr.b1 - fr.b0);
-      double r2 = x * x + y * y;
-      if (r2 >= kInnerR2) return -1.0;
-      c = std::sqrt(1 - r2);
-    } else {
-      double u0 = fr.a0 * fr.a0, u1 = fr.a1 * fr.a1;
-      c = std::sqrt(u0 + t1 * (u1 - u0));
-      if (!(float(c) > 0)) return -1.0;
-      double ph = M_PI * (fr.b0 + t2 * (fr.b1 - fr.b0)), rr = std::sqrt((1 - c) * (1 + c));
-      x = rr * std::cos(ph);
-      y = rr * std::sin(ph);
-      if (fr.kind == QT_PROPOSAL_POLAR_CUT && (x < cell.a0 || x > cell.a1 || y < cell.b0 || y > cell.b1)) return -1.0;
-    }
+    if (!(t1 >= 0 && t1 <= 1 && t2 >= 0 && t2 <= 1) ||
+        !proposalPoint(fr.kind, fr.a0, fr.a1, fr.b0, fr.b1, cell.a0, cell.a1, cell.b0, cell.b1, t1, t2, x, y, c))
+      return -1.0;
     double f = quadEvalLum(m_model, m_params, vec3(float(x), float(y), float(c)), m_v);
     ++m_evals;
     all.pts.push_back({float(x), float(y), float(c), NAN, float(f), -1});
@@ -1098,22 +1111,11 @@ EnvelopeAudit auditEnvelopes(std::uint32_t model, const BrdfParams& params, vec3
                 for (int i = 0; i <= grid; ++i)
                   for (int j = 0; j <= grid; ++j) {
                     double t1 = double(i) / grid, t2 = double(j) / grid, x, y, c;
-                    if (kind == QT_PROPOSAL_SQUARE) {
-                      x = x0 + size * t1;
-                      y = y0 + size * t2;
-                      double r2 = x * x + y * y;
-                      if (r2 >= 1) continue;
-                      c = std::sqrt(1 - r2);
-                    } else {
-                      double u0 = double(L.box.x) * L.box.x, u1 = double(L.box.y) * L.box.y;
-                      c = std::sqrt(u0 + t1 * (u1 - u0));
-                      if (!(float(c) > 0)) continue;
-                      double r = std::sqrt((1 - c) * (1 + c)), ph = M_PI * (L.box.z + t2 * (double(L.box.w) - L.box.z));
-                      x = r * std::cos(ph);
-                      y = r * std::sin(ph);
-                      if (kind == QT_PROPOSAL_POLAR_CUT && (x < x0 || x > x0 + size || y < y0 || y > y0 + size)) continue;
-                    }
-                    double e = A * std::exp(k1 * (t1 - 0.5) + k2 * (t2 - 0.5)) + (B > 0 ? B * std::pow(c, -s) : 0.0);
+                    bool square = kind == QT_PROPOSAL_SQUARE;
+                    if (!proposalPoint(int(kind), square ? x0 : L.box.x, square ? x0 + size : L.box.y, square ? y0 : L.box.z,
+                                       square ? y0 + size : L.box.w, x0, x0 + size, y0, y0 + size, t1, t2, x, y, c))
+                      continue;
+                    double e = envelopeAt(A, k1, k2, B, s, t1, t2, c);
                     double f = quadEvalLum(model, params, vec3(float(x), float(y), float(c)), v);
                     ++a.evaluations;
                     if (f > 0) worst = std::max(worst, e > 0 ? f / e : INFINITY);
