@@ -167,5 +167,27 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
   return true;
 }
 
+// The factor by which a refraction's radiance scaling (n_wo / n_wi)^2 is undone for the throughput
+// roulette (pbrt's and Mitsuba's etaScale): (n_wi / n_wo)^2 for a sample of `model` that crossed the
+// surface, 1 for everything else (only the dielectric transmits).
+SHARED_FN float transmissionEtaScale(uint model, BrdfParams p, bool inside) {
+  if (model != MODEL_DIELECTRIC) return 1.0f;
+  float eta = brdfParam(p, DIELECTRIC_ETA);
+  float etaRel = inside ? 1.0f / eta : eta;
+  return etaRel * etaRel;
+}
+
+// The throughput roulette (ROULETTE_THROUGHPUT): from bounce ROULETTE_MIN_BOUNCE on, the walk goes on
+// with probability q = min(1, max_c beta_c x etaScale) and the survivors are divided by q (unbiased:
+// E[beta'] = q beta / q). beta already includes this bounce's sample weight. No channel grows: a
+// survivor's largest channel becomes 1 / etaScale at most when q < 1. False: the walk ends.
+SHARED_FN bool throughputRoulette(uint bounce, INOUT(vec3) beta, float etaScale, float u) {
+  if (bounce < ROULETTE_MIN_BOUNCE) return true;
+  float q = min(1.0f, maxComponent(beta) * etaScale);
+  if (!(q > 0.0f) || u >= q) return false;
+  beta = beta / q;
+  return true;
+}
+
 SHARED_END
 #endif

@@ -18,10 +18,30 @@
 //
 // Uniform mode (for comparison): P_k = 1/n, then a separate roulette with probability
 // q = min(1, S) (the same albedo estimates); weight w_k f_k cos / (P_k q pdf_k).
+//
+// Under the throughput roulette (ROULETTE_THROUGHPUT, the default) the choice ends nothing: the
+// proportional mode (COMPONENTS_PROPORTIONAL, chosen by combinedChoiceMode) takes P_k = a_k / S
+// with a_k = w_k x the LARGEST RGB channel of the component's albedo (componentChoiceMaxAlbedo),
+// then the path's throughput roulette decides whether the walk goes on. A luminance choice would
+// multiply a saturated component's dominant channel by albedo_c / luminance (3.7 for the Cornell
+// box's red wall) whenever it is picked; with the largest channel the weight of a component k,
+// S x (its sample weight) / (w_k max_c A_k), stays below S per channel for components whose colour
+// does not vary with direction (Lambert: exactly S rho_c / max rho), a bounded factor otherwise.
 #ifndef NUSSELT_COMBINED_H
 #define NUSSELT_COMBINED_H
 #include "bsdf_sampling.h"
 SHARED_BEGIN
+
+// The proportional choice of the throughput roulette (never ends the walk; see the top). Not a
+// value of Globals.options.y: combinedChoiceMode derives it.
+#define COMPONENTS_PROPORTIONAL 2u
+
+// The choice mode of a render: the source's albedo choice (which includes the roulette) under the
+// albedo roulette, the proportional one under the throughput roulette; uniform stays uniform.
+SHARED_FN uint combinedChoiceMode(uint components, uint roulette) {
+  if (components == COMPONENTS_UNIFORM) return COMPONENTS_UNIFORM;
+  return roulette == ROULETTE_ALBEDO ? COMPONENTS_ALBEDO : COMPONENTS_PROPORTIONAL;
+}
 
 // Component k's value in a vec4 of per-component numbers (k < MAX_COMPONENTS).
 SHARED_FN float componentAt(vec4 v, uint k) {
@@ -51,6 +71,23 @@ SHARED_FN float componentChoiceAlbedo(uint strategy, uint model, GpuComponent C,
   return w * componentTableAlbedo(C.albedoLo, C.albedoHi, wo.z);
 }
 
+// a_k = w_k max_c A_k,c(wo): the choice weight of the proportional mode, from wo only. The CPU
+// tabulates the largest channel of every non-delta component's albedo (GpuComponent.albedoLo/Hi)
+// for this mode; a mirror takes its largest Fresnel channel, a dielectric 1 (lossless).
+SHARED_FN float componentChoiceMaxAlbedo(uint model, GpuComponent C, vec3 wo) {
+  float w = C.data.x;
+  if (!(w > 0.0f) || wo.z <= 0.0f) return 0.0f;
+  if (model == MODEL_MIRROR) return w * maxComponent(mirrorReflectance(C.params, wo.z));
+  if (model == MODEL_DIELECTRIC) return w;
+  return w * componentTableAlbedo(C.albedoLo, C.albedoHi, wo.z);
+}
+
+// The choice weight a_k of the render's choice mode (combinedChoiceMode).
+SHARED_FN float componentChoiceWeight(uint choiceMode, uint strategy, uint model, GpuComponent C, vec3 wo) {
+  if (choiceMode == COMPONENTS_PROPORTIONAL) return componentChoiceMaxAlbedo(model, C, wo);
+  return componentChoiceAlbedo(strategy, model, C, wo);
+}
+
 // Choice probabilities P_k of the n = count components from their choice weights a (see the top).
 // Their sum is min(1, S) in albedo mode (the rest ends the walk), 1 in uniform mode.
 SHARED_FN vec4 combinedChoiceProbabilities(uint mode, uint count, vec4 a) {
@@ -59,6 +96,7 @@ SHARED_FN vec4 combinedChoiceProbabilities(uint mode, uint count, vec4 a) {
     return vec4(count > 0u ? p : 0.0f, count > 1u ? p : 0.0f, count > 2u ? p : 0.0f, count > 3u ? p : 0.0f);
   }
   float s = a.x + a.y + a.z + a.w;
+  if (mode == COMPONENTS_PROPORTIONAL) return s > 0.0f ? a / s : vec4(0.0f);
   // The guard against throughput growth of non-energy-conserving sets: a probability never
   // exceeds 1; the weight divides by the probability actually used.
   return s > 1.0f ? a / s : a;
@@ -77,8 +115,9 @@ SHARED_FN vec4 combinedMisProbabilities(vec4 P) {
 
 // Picks component k with probability P_k (combinedChoiceProbabilities(mode, count, a)) from one
 // uniform number u and returns P_k in pk; false (the walk ends) with probability 1 - sum P_k.
-// Compares u * max(1, S) with the running sum of a, so no rounding of a / S can open a gap: when
-// S > 1 the walk never ends here (the last positive component takes the sliver u * S == S).
+// Compares u * max(1, S) (u * S in proportional mode) with the running sum of a, so no rounding of
+// a / S can open a gap: when S > 1, or in proportional mode, the walk never ends here (the last
+// positive component takes the sliver u * S == S).
 SHARED_FN bool combinedPick(uint mode, uint count, vec4 a, float u, OUT(uint) k, OUT(float) pk) {
   k = 0u;
   pk = 0.0f;
@@ -89,7 +128,9 @@ SHARED_FN bool combinedPick(uint mode, uint count, vec4 a, float u, OUT(uint) k,
     return true;
   }
   float s = a.x + a.y + a.z + a.w;
-  float scale = max(1.0f, s);
+  const bool proportional = mode == COMPONENTS_PROPORTIONAL;
+  if (proportional && !(s > 0.0f)) return false;
+  float scale = proportional ? s : max(1.0f, s);
   float target = u * scale;
   float acc = 0.0f;
   for (uint i = 0u; i < MAX_COMPONENTS; ++i) {
@@ -101,7 +142,7 @@ SHARED_FN bool combinedPick(uint mode, uint count, vec4 a, float u, OUT(uint) k,
       return true;
     }
   }
-  if (s > 1.0f) {  // the rounding sliver: the last positive component
+  if (s > 1.0f || proportional) {  // the rounding sliver: the last positive component
     for (uint i = 0u; i < MAX_COMPONENTS; ++i)
       if (componentAt(a, i) > 0.0f) k = i;
     pk = componentAt(a, k) / scale;

@@ -64,6 +64,17 @@ SHARED_BEGIN
 // probability 1/n and play a separate albedo roulette (for the speed-versus-error comparison).
 #define COMPONENTS_ALBEDO 0u
 #define COMPONENTS_UNIFORM 1u
+// Russian roulette (Globals.options.z). throughput (the default): from bounce ROULETTE_MIN_BOUNCE
+// on, continue with q = min(1, largest channel of the path throughput x etaScale) and divide the
+// survivors by q: no channel is ever amplified. albedo: the random-walk source's roulette, q = the
+// sample's luminance albedo (its survivors' saturated channels grow by albedo_c / luminance at
+// every bounce: 3.7x per bounce on the Cornell box's red wall).
+#define ROULETTE_THROUGHPUT 0u
+#define ROULETTE_ALBEDO 1u
+// No roulette on the camera hit and the two bounces after it: short paths carry most of the
+// image, and killing them costs more variance than tracing them (Mitsuba starts at its 5th
+// vertex, pbrt-v4 after the first bounce).
+#define ROULETTE_MIN_BOUNCE 3u
 // Nodes of a component's tabulated albedo estimate (GpuComponent.albedo): cos theta_o = i / 7.
 #define COMPONENT_ALBEDO_NODES 8u
 
@@ -125,9 +136,11 @@ STATIC_ASSERT_SIZE(GpuMaterial, 176);
 
 // One term w * f_k of a combined material (shaders/shared/combined.h).
 // info = (model id, quadtree set index or INVALID_INDEX, 0, 0); data = (weight w, 0, 0, 0);
-// albedoLo, albedoHi = the component's directional albedo (luminance, without w) at cos theta_o =
-// i / 7, i = 0..3 in albedoLo and 4..7 in albedoHi, computed on the CPU for components that have no QuadSet (their
-// choice probability must be known before sampling; quadtree components use quadAlbedo).
+// albedoLo, albedoHi = the component's directional albedo (without w) at cos theta_o = i / 7, i = 0..3
+// in albedoLo and 4..7 in albedoHi, computed on the CPU: its largest RGB channel under the throughput
+// roulette (every non-delta component), its luminance under the albedo roulette (components without
+// a QuadSet; quadtree components then use quadAlbedo). The choice probability must be known before
+// sampling.
 struct GpuComponent {
   uvec4 info;
   vec4 data;
@@ -185,7 +198,7 @@ struct Globals {
   uvec4 image;      // width, height, first pixel of this chunk, pixels in this chunk
   uvec4 frame;      // sample index of this pass, seed, max depth, path capacity
   uvec4 counts;     // materials, lights, triangles, lighting mode (LIGHTING_*)
-  uvec4 options;    // random numbers (RNG_PCG / RNG_QMC), component choice (COMPONENTS_*), 0, 0
+  uvec4 options;    // random numbers (RNG_PCG / RNG_QMC), component choice (COMPONENTS_*), roulette (ROULETTE_*), 0
   vec4 camPosition; // xyz, w = 1 for orthographic
   vec4 camRight;    // unit right * (tan(yfov/2) * aspect), or * xmag for orthographic
   vec4 camUp;       // unit up * tan(yfov/2), or * ymag for orthographic
@@ -204,7 +217,8 @@ struct Globals {
   BUFREF(Vec4s) filmSq;        // per pixel: sum of squared samples (rgb)
   BUFREF(Vec4s) pathOrigin;    // per path: ray origin
   BUFREF(Vec4s) pathDirection; // per path: ray direction, w = pdf of the BSDF sample (0: delta/camera)
-  BUFREF(Vec4s) pathThroughput;// per path: throughput (rgb)
+  BUFREF(Vec4s) pathThroughput;// per path: throughput (rgb), w = etaScale (the product of (n_t / n_i)^2 over
+                               // refractions, which undoes their radiance scaling for the roulette)
   BUFREF(Vec4s) pathRadiance;  // per path: radiance gathered so far (rgb)
   BUFREF(UVec4s) pathInfo;     // per path: (pixel, flags, 0, 0)
   BUFREF(Vec4s) pathHit;       // per path: (t, b1, b2, triangle bits)

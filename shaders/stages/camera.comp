@@ -29,7 +29,7 @@ void main() {
 
   g.pathOrigin.v[i] = vec4(origin, 0.0f);
   g.pathDirection.v[i] = vec4(dir, 0.0f);  // w = 0: no BSDF pdf yet (camera ray)
-  g.pathThroughput.v[i] = vec4(1.0f, 1.0f, 1.0f, 0.0f);
+  g.pathThroughput.v[i] = vec4(1.0f, 1.0f, 1.0f, 1.0f);  // w: etaScale
   g.pathRadiance.v[i] = vec4(0.0f);
   g.pathInfo.v[i] = uvec4(pixel, 0u, 0u, 0u);
   g.queues.v[QUEUE_HEADER_UINTS + QUEUE_RAY0 * g.frame.w + i] = i;

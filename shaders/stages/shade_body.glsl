@@ -46,6 +46,7 @@ void main() {
   uint seed = g.frame.y;
   uint lighting = g.counts.w;
   uint rngMode = g.options.x;
+  uint roulette = g.options.z;
 
   // ---- Hit geometry ----
   vec4 hit = g.pathHit.v[path];
@@ -60,7 +61,9 @@ void main() {
   vec3 ngFront = normalize(cross(T.e1.xyz, T.e2.xyz));
   vec3 ns = normalize((1.0f - hit.y - hit.z) * S.n0.xyz + hit.y * S.n1.xyz + hit.z * S.n2.xyz);
   GpuMaterial M = g.materials.v[S.info.x];
-  vec3 beta = g.pathThroughput.v[path].xyz;
+  vec4 throughput = g.pathThroughput.v[path];
+  vec3 beta = throughput.xyz;
+  float etaScale = throughput.w;
   vec3 L = vec3(0.0f);
 
   // ---- Emission: one-sided emitters radiate along their geometric normal ----
@@ -140,15 +143,21 @@ void main() {
     if (transmitted != (dot(wi, ng) < 0.0f)) return;
     if (transmitted) xo = offsetRay(x, -ng);
 
-    // ---- Russian roulette with the continuation probability of the sample (the albedo) ----
-    // Surviving paths are divided by the probability (unbiased).
+    // ---- Russian roulette: on the throughput (default), or with the continuation probability
+    // of the sample (the source's albedo roulette). Survivors are divided by the probability.
     float uR = sample1(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_ROULETTE), seed);
-    if (!(q > 0.0f) || uR >= q) return;
-    beta *= weight / q;
+    if (roulette == ROULETTE_ALBEDO) {
+      if (!(q > 0.0f) || uR >= q) return;
+      beta *= weight / q;
+    } else {
+      beta *= weight;
+      if (transmitted) etaScale *= transmissionEtaScale(MODEL_ID, M.params, !frontFace);
+      if (!throughputRoulette(bounce, beta, etaScale, uR)) return;
+    }
 
     g.pathOrigin.v[path] = vec4(xo, 0.0f);
     g.pathDirection.v[path] = vec4(wi, pdf);
-    g.pathThroughput.v[path] = vec4(beta, 0.0f);
+    g.pathThroughput.v[path] = vec4(beta, etaScale);
     queuePush(((bounce + 1u) & 1u), path);
     return;
   }
@@ -158,11 +167,11 @@ void main() {
   GpuComponent C0, C1, C2, C3;
   vec4 a = vec4(0.0f);  // choice weights a_k = w_k A_k(wo), from wo only
   uint first = M.components.x;
-  if (COMPONENT_COUNT > 0u) { C0 = g.components.v[first]; a.x = componentChoiceAlbedo(SAMPLER, MODEL_0, C0, wo); }
-  if (COMPONENT_COUNT > 1u) { C1 = g.components.v[first + 1u]; a.y = componentChoiceAlbedo(SAMPLER, MODEL_1, C1, wo); }
-  if (COMPONENT_COUNT > 2u) { C2 = g.components.v[first + 2u]; a.z = componentChoiceAlbedo(SAMPLER, MODEL_2, C2, wo); }
-  if (COMPONENT_COUNT > 3u) { C3 = g.components.v[first + 3u]; a.w = componentChoiceAlbedo(SAMPLER, MODEL_3, C3, wo); }
-  uint mode = g.options.y;
+  uint mode = combinedChoiceMode(g.options.y, roulette);
+  if (COMPONENT_COUNT > 0u) { C0 = g.components.v[first]; a.x = componentChoiceWeight(mode, SAMPLER, MODEL_0, C0, wo); }
+  if (COMPONENT_COUNT > 1u) { C1 = g.components.v[first + 1u]; a.y = componentChoiceWeight(mode, SAMPLER, MODEL_1, C1, wo); }
+  if (COMPONENT_COUNT > 2u) { C2 = g.components.v[first + 2u]; a.z = componentChoiceWeight(mode, SAMPLER, MODEL_2, C2, wo); }
+  if (COMPONENT_COUNT > 3u) { C3 = g.components.v[first + 3u]; a.w = componentChoiceWeight(mode, SAMPLER, MODEL_3, C3, wo); }
   vec4 P = combinedChoiceProbabilities(mode, COMPONENT_COUNT, a);
   vec4 c = combinedMisProbabilities(P);
   // Delta components take no light samples and have no MIS density: their c is dropped below.
@@ -200,7 +209,7 @@ void main() {
   g.pathRadiance.v[path].xyz += L;
   if (last) return;
 
-  // ---- Component choice (albedo mode: includes the roulette) ----
+  // ---- Component choice (albedo mode under the albedo roulette: includes the roulette) ----
   float uC = sample1(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_COMPONENT), seed);
   uint k;
   float pk;
@@ -217,25 +226,30 @@ void main() {
   bool ok = false;
   bool delta = false;
   float wk = 0.0f;
+  float etaK = 1.0f;  // transmissionEtaScale of the chosen component
   if (COMPONENT_COUNT > 0u && k == 0u) {
     ok = bsdfSample(SAMPLER, MODEL_0, C0.info.y, C0.params, wo, !frontFace, uB, key, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_0);
     wk = C0.data.x;
+    etaK = transmissionEtaScale(MODEL_0, C0.params, !frontFace);
   }
   if (COMPONENT_COUNT > 1u && k == 1u) {
     ok = bsdfSample(SAMPLER, MODEL_1, C1.info.y, C1.params, wo, !frontFace, uB, key, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_1);
     wk = C1.data.x;
+    etaK = transmissionEtaScale(MODEL_1, C1.params, !frontFace);
   }
   if (COMPONENT_COUNT > 2u && k == 2u) {
     ok = bsdfSample(SAMPLER, MODEL_2, C2.info.y, C2.params, wo, !frontFace, uB, key, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_2);
     wk = C2.data.x;
+    etaK = transmissionEtaScale(MODEL_2, C2.params, !frontFace);
   }
   if (COMPONENT_COUNT > 3u && k == 3u) {
     ok = bsdfSample(SAMPLER, MODEL_3, C3.info.y, C3.params, wo, !frontFace, uB, key, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_3);
     wk = C3.data.x;
+    etaK = transmissionEtaScale(MODEL_3, C3.params, !frontFace);
   }
   if (!ok || !(wk > 0.0f)) return;
   vec3 wi = toWorld(wiLocal, tt, bb, ns);
@@ -243,15 +257,20 @@ void main() {
   if (transmitted != (dot(wi, ng) < 0.0f)) return;
   if (transmitted) xo = offsetRay(x, -ng);
 
-  // ---- Weight: w_k f_k cos / (P_k pdf_k); uniform mode adds its separate albedo roulette ----
+  // ---- Weight: w_k f_k cos / (P_k pdf_k); then the throughput roulette, or (albedo roulette)
+  // uniform mode's separate albedo roulette ----
   float p = pk;
-  if (mode == COMPONENTS_UNIFORM) {
-    float uR = sample1(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_ROULETTE), seed);
+  float uR = sample1(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_ROULETTE), seed);
+  if (roulette == ROULETTE_ALBEDO && mode == COMPONENTS_UNIFORM) {
     float q = combinedUniformContinuation(a);
     if (!(q > 0.0f) || uR >= q) return;
     p *= q;
   }
   beta *= weight * (wk / p);
+  if (roulette != ROULETTE_ALBEDO) {
+    if (transmitted) etaScale *= etaK;
+    if (!throughputRoulette(bounce, beta, etaScale, uR)) return;
+  }
 
   // MIS density of the sampled direction: sum over the non-delta components (0 after a delta lobe).
   float misPdf = 0.0f;
@@ -264,7 +283,7 @@ void main() {
 
   g.pathOrigin.v[path] = vec4(xo, 0.0f);
   g.pathDirection.v[path] = vec4(wi, misPdf);
-  g.pathThroughput.v[path] = vec4(beta, 0.0f);
+  g.pathThroughput.v[path] = vec4(beta, etaScale);
   queuePush(((bounce + 1u) & 1u), path);
 #endif
 }

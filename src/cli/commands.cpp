@@ -43,6 +43,7 @@ struct RenderArgs {
   std::string rng = "pcg";
   std::string sampler = "quadtree";
   std::string components = "albedo";
+  std::string roulette = "throughput";
   bool variance = false;
   bool validation = false;
   bool quiet = false;
@@ -74,8 +75,9 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
   meta.strings = {{"nusselt/version", NUSSELT_VERSION},
                   {"nusselt/scene", r.scene},
                   {"nusselt/device", r.device},
-                  {"nusselt/integrator", "wavefront path tracer: NEE + BSDF sampling, MIS power heuristic, "
-                                         "albedo Russian roulette"},
+                  {"nusselt/integrator", std::string("wavefront path tracer: NEE + BSDF sampling, MIS power "
+                                         "heuristic, ") + rouletteModeName(r.settings.roulette) + " Russian roulette"},
+                  {"nusselt/roulette", rouletteModeName(r.settings.roulette)},
                   {"nusselt/lighting", lightingModeName(r.settings.lighting)},
                   {"nusselt/rng", rngModeName(r.settings.rng)},
                   {"nusselt/sampler", samplerName(r.settings.sampler)},
@@ -122,6 +124,9 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   // Absent in files written before combined materials existed: those rendered in albedo mode.
   if (!parseComponentSelection(findString(meta, "nusselt/components").value_or("albedo"), r.settings.components))
     throw Error(path + ": header attribute nusselt/components names an unknown component selection");
+  // Absent in files written before the throughput roulette existed: those used the albedo roulette.
+  if (!parseRouletteMode(findString(meta, "nusselt/roulette").value_or("albedo"), r.settings.roulette))
+    throw Error(path + ": header attribute nusselt/roulette names an unknown roulette");
   r.spp = static_cast<std::uint32_t>(num("nusselt/spp"));
   r.settings.sampleOffset = static_cast<std::uint32_t>(num("nusselt/sppOffset"));
   r.settings.seed = static_cast<std::uint32_t>(num("nusselt/seed"));
@@ -169,6 +174,7 @@ int renderCommand(const RenderArgs& a) {
   s.rng = a.rng == "qmc" ? RngMode::Qmc : RngMode::Pcg;
   parseSampler(a.sampler, s.sampler);
   parseComponentSelection(a.components, s.components);
+  parseRouletteMode(a.roulette, s.roulette);
   // Image size: defaults follow the camera's aspect ratio when only one side (or none) is given.
   float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
   s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u);
@@ -195,6 +201,7 @@ int renderCommand(const RenderArgs& a) {
     mismatch("--rng", rngModeName(previous.settings.rng), rngModeName(s.rng));
     mismatch("--sampler", samplerName(previous.settings.sampler), samplerName(s.sampler));
     mismatch("--components", componentSelectionName(previous.settings.components), componentSelectionName(s.components));
+    mismatch("--roulette", rouletteModeName(previous.settings.roulette), rouletteModeName(s.roulette));
     mismatch("--spp-offset", std::to_string(previous.settings.sampleOffset), std::to_string(s.sampleOffset));
     if (saved.sum.empty() || saved.sumSq.empty())
       throw Error("--resume " + a.resume + ": no accumulation channels (sum.R/G/B, sumSq.R/G/B)");
@@ -237,10 +244,12 @@ int renderCommand(const RenderArgs& a) {
         std::fprintf(stderr, "sampler: %u quadtrees (%.1f MiB) in %.2f s (cache: %u hits, %u built, %u rejected)\n",
                      sum.samplerTrees, sum.samplerBytes / 1048576.0, sum.samplerSeconds, sum.samplerCacheHits,
                      sum.samplerCacheMisses, sum.samplerCacheRejected);
-      std::fprintf(stderr, "device: %s; %ux%u, %u spp%s, max depth %u, seed %u, lighting %s, rng %s, sampler %s\n",
+      std::fprintf(stderr, "device: %s; %ux%u, %u spp%s, max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
+                           "roulette %s\n",
                    ctx.deviceName.c_str(), s.width, s.height, s.spp,
                    a.resume.empty() ? "" : (" (resuming from " + std::to_string(previous.spp) + ")").c_str(),
-                   s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng), samplerName(s.sampler));
+                   s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng), samplerName(s.sampler),
+                   rouletteModeName(s.roulette));
     }
 
     auto tRender = std::chrono::steady_clock::now();
@@ -362,6 +371,7 @@ int mergeCommand(const std::vector<std::string>& inputs, const std::string& outp
       same("the sampler", samplerName(merged.settings.sampler), samplerName(r.settings.sampler));
       same("the component selection", componentSelectionName(merged.settings.components),
            componentSelectionName(r.settings.components));
+      same("the roulette", rouletteModeName(merged.settings.roulette), rouletteModeName(r.settings.roulette));
       for (std::size_t i = 0; i < total.sum.size(); ++i) {
         total.sum[i] += img.sum[i];
         total.sumSq[i] += img.sumSq[i];
@@ -615,6 +625,12 @@ int runCli(int argc, char** argv) {
                                                     "the walk: the random-walk source's estimator) or uniform "
                                                     "(probability 1/n and a separate albedo roulette)")
       ->capture_default_str()->check(CLI::IsMember({"albedo", "uniform"}));
+  render->add_option("--roulette", ra.roulette, "Russian roulette: throughput (continue with the path throughput's "
+                                                "largest channel from the third bounce on; never amplifies a colour "
+                                                "channel) or albedo (the random-walk source's: continue with the "
+                                                "sample's luminance albedo; its survivors' saturated channels grow, "
+                                                "docs/performance.md)")
+      ->capture_default_str()->check(CLI::IsMember({"throughput", "albedo"}));
   render->add_option("--rng", ra.rng, "Random numbers: pcg (independent hashes) or qmc (padded Owen-scrambled Sobol)")
       ->capture_default_str()->check(CLI::IsMember({"pcg", "qmc"}));
   render->add_option("--checkpoint", ra.checkpointSeconds, "Write the image so far to the output every this many seconds "

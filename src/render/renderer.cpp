@@ -70,6 +70,17 @@ bool parseSampler(const std::string& name, SamplerKind& kind) {
   return false;
 }
 
+const char* rouletteModeName(RouletteMode mode) { return mode == RouletteMode::Albedo ? "albedo" : "throughput"; }
+
+bool parseRouletteMode(const std::string& name, RouletteMode& mode) {
+  for (RouletteMode m : {RouletteMode::Throughput, RouletteMode::Albedo})
+    if (name == rouletteModeName(m)) {
+      mode = m;
+      return true;
+    }
+  return false;
+}
+
 const char* rngModeName(RngMode mode) { return mode == RngMode::Qmc ? "qmc" : "pcg"; }
 
 namespace {
@@ -399,17 +410,29 @@ void Renderer::uploadScene(const Scene& scene) {
     m_summary.samplerCacheRejected = qt.cacheRejected;
     vk::uploadBuffer(m_ctx, *materialBuffer, materials.data(), materials.size() * sizeof(GpuMaterial));
   }
-  // Components without a QuadSet (other samplers) choose by a CPU-tabulated albedo over
-  // cos theta_o (the choice probability must be known before sampling; any positive function of
-  // wo keeps the estimator unbiased, the albedo keeps the weights near 1). Floored at 1e-4 so
-  // that no component whose BRDF is not zero is ever left unsampled.
+  // Components choose by a CPU-tabulated albedo over cos theta_o (the choice probability must be
+  // known before sampling; any positive function of wo keeps the estimator unbiased, the albedo
+  // keeps the weights near 1): its largest RGB channel for every non-delta component under the
+  // throughput roulette (combined.h: no channel is amplified), its luminance under the albedo
+  // roulette for the components without a QuadSet (quadtree components read their set's table).
+  // Floored at 1e-4 so that no component whose BRDF is not zero is ever left unsampled.
+  const bool maxChannel = m_settings.roulette == RouletteMode::Throughput;
   for (GpuComponent& c : components) {
     // (Only quadtree components read their albedo from their set: tabulated ones use this table too.)
-    if (modelById(c.info.x).delta || (m_settings.sampler == SamplerKind::Quadtree && c.info.y != INVALID_INDEX)) continue;
+    if (modelById(c.info.x).delta) continue;
+    if (!maxChannel && m_settings.sampler == SamplerKind::Quadtree && c.info.y != INVALID_INDEX) continue;
     float table[COMPONENT_ALBEDO_NODES];
     for (std::uint32_t n = 0; n < COMPONENT_ALBEDO_NODES; ++n) {
       double cosTheta = std::max(double(n) / (COMPONENT_ALBEDO_NODES - 1), 0.02);
-      double a = directionalAlbedo(c.info.x, c.params, std::acos(cosTheta) * 180.0 / M_PI);
+      double thetaDeg = std::acos(cosTheta) * 180.0 / M_PI;
+      double a;
+      if (maxChannel) {
+        double rgb[3];
+        directionalAlbedoRgb(c.info.x, c.params, thetaDeg, 0.0, rgb);
+        a = std::max(rgb[0], std::max(rgb[1], rgb[2]));
+      } else {
+        a = directionalAlbedo(c.info.x, c.params, thetaDeg);
+      }
       table[n] = std::isfinite(a) ? std::max(float(a), 1e-4f) : 1e-4f;
     }
     c.albedoLo = glm::vec4(table[0], table[1], table[2], table[3]);
@@ -445,7 +468,7 @@ void Renderer::uploadScene(const Scene& scene) {
   g.counts = glm::uvec4(static_cast<std::uint32_t>(materials.size()), static_cast<std::uint32_t>(weights.size()),
                         static_cast<std::uint32_t>(triCount), static_cast<std::uint32_t>(m_settings.lighting));
   g.options = glm::uvec4(static_cast<std::uint32_t>(m_settings.rng), static_cast<std::uint32_t>(m_settings.components),
-                         0u, 0u);
+                         static_cast<std::uint32_t>(m_settings.roulette), 0u);
   m_globals.resize(sizeof(Globals));
   std::memcpy(m_globals.data(), &g, sizeof g);
   writeCamera(m_cameraState);

@@ -32,6 +32,13 @@ enum class ComponentSelection : std::uint32_t { Albedo = 0, Uniform = 1 };
 const char* componentSelectionName(ComponentSelection mode);
 bool parseComponentSelection(const std::string& name, ComponentSelection& mode);
 
+// Russian roulette (ROULETTE_* in layout.h): throughput = continue with the path throughput's
+// largest channel from the third bounce on (the default: never amplifies a channel); albedo = the
+// random-walk source's roulette by the sample's luminance albedo (for comparison).
+enum class RouletteMode : std::uint32_t { Throughput = 0, Albedo = 1 };
+const char* rouletteModeName(RouletteMode mode);
+bool parseRouletteMode(const std::string& name, RouletteMode& mode);
+
 struct RenderSettings {
   std::uint32_t width = 512;
   std::uint32_t height = 512;
@@ -42,6 +49,7 @@ struct RenderSettings {
   RngMode rng = RngMode::Pcg;
   SamplerKind sampler = SamplerKind::Quadtree;  // the generic sampler of Montes et al.
   ComponentSelection components = ComponentSelection::Albedo;  // combined materials only
+  RouletteMode roulette = RouletteMode::Throughput;
   // The quadtree sampler's table counts (quadtree::QuadtreeSettings; the paper's 90 and 16 by
   // default; phi only for anisotropic sets). Fewer tables build faster (the hard-case tests use
   // 90 x 4 for the anisotropic hard sets) at the cost of a coarser grid in the outgoing direction:

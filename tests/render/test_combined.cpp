@@ -206,9 +206,12 @@ TEST(CombinedFurnace, NonEnergyConservingSetIsTheFiniteSeries) {
   expectFurnace(scene, s, expected, expected);
 }
 
-// Uniform choice with a separate albedo roulette estimates the same value as the albedo choice
-// (three components, one of them delta): a two-sample z-test of the image means per channel at
-// significance 0.001 (Bonferroni over the channels), different seeds (independent estimates).
+// Uniform choice estimates the same value as the albedo choice (three components, one of them
+// delta), under both roulettes: with the albedo roulette (the source's choice P_k = a_k against
+// uniform choice plus a separate albedo roulette) and with the throughput roulette (the
+// proportional choice by the largest channel against uniform choice). A two-sample z-test of the
+// image means per channel at significance 0.001 (Bonferroni over 3 channels x 2 roulettes),
+// different seeds (independent estimates).
 TEST(CombinedFurnace, UniformSelectionMatchesAlbedoSelection) {
   Scene scene = furnace({component("lambert", {{"rho", ParamValue::num(0.25)}}),
                          component("phong", {{"kd", ParamValue::num(0)}, {"ks", ParamValue::num(0.3)},
@@ -216,16 +219,19 @@ TEST(CombinedFurnace, UniformSelectionMatchesAlbedoSelection) {
                          component("mirror", {{"eta", ParamValue::num(0.96)}, {"k", ParamValue::num(6.69)}}, 0.2f)});
   // Any value: only the two modes are compared here (the interval tests above check the level).
   const double lo[3] = {0, 0, 0}, hi[3] = {1e9, 1e9, 1e9};
-  RenderSettings s = furnaceSettings();
-  Estimate albedo = expectFurnace(scene, s, lo, hi);
-  s.components = ComponentSelection::Uniform;
-  s.seed = 8;
-  Estimate uniform = expectFurnace(scene, s, lo, hi);
-  const double zMax = test::normalQuantileUpper(0.001 / 3 / 2);
-  for (int c = 0; c < 3; ++c) {
-    double z = (albedo.mean[c] - uniform.mean[c]) / std::hypot(albedo.se[c], uniform.se[c]);
-    std::printf("[ furnace  ] channel %d: albedo %.5f +- %.5f, uniform %.5f +- %.5f, z = %.2f\n", c, albedo.mean[c],
-                albedo.se[c], uniform.mean[c], uniform.se[c], z);
-    EXPECT_LT(std::fabs(z), zMax) << "channel " << c;
+  const double zMax = test::normalQuantileUpper(0.001 / 6 / 2);
+  for (RouletteMode roulette : {RouletteMode::Albedo, RouletteMode::Throughput}) {
+    RenderSettings s = furnaceSettings();
+    s.roulette = roulette;
+    Estimate albedo = expectFurnace(scene, s, lo, hi);
+    s.components = ComponentSelection::Uniform;
+    s.seed = 8;
+    Estimate uniform = expectFurnace(scene, s, lo, hi);
+    for (int c = 0; c < 3; ++c) {
+      double z = (albedo.mean[c] - uniform.mean[c]) / std::hypot(albedo.se[c], uniform.se[c]);
+      std::printf("[ furnace  ] %s roulette, channel %d: albedo %.5f +- %.5f, uniform %.5f +- %.5f, z = %.2f\n",
+                  rouletteModeName(roulette), c, albedo.mean[c], albedo.se[c], uniform.mean[c], uniform.se[c], z);
+      EXPECT_LT(std::fabs(z), zMax) << rouletteModeName(roulette) << " roulette, channel " << c;
+    }
   }
 }

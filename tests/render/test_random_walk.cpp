@@ -72,9 +72,9 @@ TEST(RandomWalk, MirrorShowsTheEmitterWhereGeometryPutsIt) {
   test::Rendered r = test::render(s, rs);
 
   // Expected value of a pixel whose whole footprint reflects onto the emitter: F(cos 45) * Le.
-  // The walk continues past the mirror with probability lum(F) (albedo roulette) carrying
-  // F / lum(F), so lit pixels are a binomial average: tested on their mean with its variance;
-  // pixels that see no emitter must be exactly 0.
+  // Lit pixels average F * Le over their samples (under the albedo roulette the walk would go on
+  // with probability lum(F) carrying F / lum(F): a binomial average), so they are tested on their
+  // mean with its variance; pixels that see no emitter must be exactly 0.
   BrdfParams mp = s.materials[0].params;
   glm::vec3 F = shared::mirrorReflectance(mp, std::sqrt(0.5f));
   const glm::vec3 right = glm::normalize(glm::cross(s.camera.forward, s.camera.up));

@@ -66,6 +66,70 @@ TEST(CombinedChoice, NonEnergyConservingSetsAreNormalised) {
   EXPECT_EQ(k, 2u);
 }
 
+TEST(CombinedChoice, ProportionalModeNeverEndsTheWalk) {
+  // The throughput roulette's choice: P_k = a_k / S whatever S is (here S = 0.65 < 1).
+  const vec4 a(0.2f, 0.0f, 0.35f, 0.1f);
+  double f[5];
+  vec4 pk;
+  frequencies(COMPONENTS_PROPORTIONAL, 4, a, f, pk);
+  const vec4 P = combinedChoiceProbabilities(COMPONENTS_PROPORTIONAL, 4, a);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_NEAR(f[k], a[k] / 0.65, 1e-5) << k;
+    EXPECT_NEAR(P[k], a[k] / 0.65, 1e-6) << k;
+    if (a[k] > 0) EXPECT_FLOAT_EQ(pk[k], P[k]) << "the weight must divide by the probability used";
+  }
+  EXPECT_EQ(f[4], 0.0) << "the choice never ends the walk: the throughput roulette does";
+  uint k;
+  float p;
+  EXPECT_TRUE(combinedPick(COMPONENTS_PROPORTIONAL, 4, a, NUSSELT_ONE_MINUS_EPS, k, p));
+  EXPECT_EQ(k, 3u);
+  EXPECT_FALSE(combinedPick(COMPONENTS_PROPORTIONAL, 4, vec4(0.0f), 0.5f, k, p)) << "no component to pick";
+  // The modes a render derives from (components, roulette).
+  EXPECT_EQ(combinedChoiceMode(COMPONENTS_ALBEDO, ROULETTE_THROUGHPUT), COMPONENTS_PROPORTIONAL);
+  EXPECT_EQ(combinedChoiceMode(COMPONENTS_ALBEDO, ROULETTE_ALBEDO), COMPONENTS_ALBEDO);
+  EXPECT_EQ(combinedChoiceMode(COMPONENTS_UNIFORM, ROULETTE_THROUGHPUT), COMPONENTS_UNIFORM);
+}
+
+TEST(CombinedChoice, MaxChannelChoiceWeights) {
+  // Proportional mode weighs a component by the largest channel of its albedo: the table for
+  // non-delta models, the largest Fresnel channel for a mirror, 1 for a dielectric.
+  GpuComponent c{};
+  c.data = vec4(0.5f, 0.0f, 0.0f, 0.0f);
+  c.albedoLo = vec4(0.6f);
+  c.albedoHi = vec4(0.6f);
+  const vec3 wo(0.0f, 0.6f, 0.8f);
+  EXPECT_NEAR(componentChoiceMaxAlbedo(MODEL_LAMBERT, c, wo), 0.3f, 1e-6);
+  EXPECT_FLOAT_EQ(componentChoiceMaxAlbedo(MODEL_DIELECTRIC, c, wo), 0.5f);
+  EXPECT_FLOAT_EQ(componentChoiceMaxAlbedo(MODEL_MIRROR, c, wo),
+                  0.5f * maxComponent(mirrorReflectance(c.params, wo.z)));
+  EXPECT_EQ(componentChoiceMaxAlbedo(MODEL_LAMBERT, c, vec3(0.0f, 0.0f, -1.0f)), 0.0f);
+}
+
+TEST(ThroughputRoulette, NeverAmplifiesAChannel) {
+  // Before ROULETTE_MIN_BOUNCE every path goes on unchanged.
+  vec3 beta(0.57f, 0.043f, 0.044f);
+  EXPECT_TRUE(throughputRoulette(ROULETTE_MIN_BOUNCE - 1u, beta, 1.0f, 0.99f));
+  EXPECT_EQ(beta.x, 0.57f);
+  // From it on, q = max channel: survivors' largest channel becomes 1, the others stay below it.
+  EXPECT_FALSE(throughputRoulette(ROULETTE_MIN_BOUNCE, beta, 1.0f, 0.6f));
+  EXPECT_TRUE(throughputRoulette(ROULETTE_MIN_BOUNCE, beta, 1.0f, 0.5f));
+  EXPECT_FLOAT_EQ(beta.x, 1.0f);
+  EXPECT_LT(beta.y, 0.1f);
+  // Unbiased: the expectation over u of the surviving throughput is the throughput.
+  const int grid = 1 << 16;
+  double mean = 0;
+  for (int i = 0; i < grid; ++i) {
+    vec3 b(0.3f, 0.1f, 0.2f);
+    if (throughputRoulette(ROULETTE_MIN_BOUNCE + 2u, b, 1.0f, (i + 0.5f) / grid)) mean += b.x / grid;
+  }
+  EXPECT_NEAR(mean, 0.3, 1e-4);
+  // Inside glass (etaScale 2.25 undoes the 1/1.5^2 radiance scaling) a path of throughput 0.44 is not
+  // killed for being inside.
+  vec3 inside(0.44f);
+  EXPECT_TRUE(throughputRoulette(ROULETTE_MIN_BOUNCE, inside, 2.25f, 0.98f));
+  EXPECT_FLOAT_EQ(transmissionEtaScale(MODEL_LAMBERT, BrdfParams{}, false), 1.0f);
+}
+
 TEST(CombinedChoice, UniformModeIsUniform) {
   const vec4 a(0.9f, 0.01f, 0.3f, 0.0f);
   double f[5];
