@@ -4,6 +4,7 @@
 // behind it (Fresnel at both faces, all internal reflections summed).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "../support/test_support.h"
@@ -110,7 +111,9 @@ TEST(RandomWalk, MirrorShowsTheEmitterWhereGeometryPutsIt) {
     }
   for (int c = 0; c < 3; ++c) {
     double expected = F[c] * s.materials[1].emission[c], mean = sum[c] / lit, se = std::sqrt(var[c]) / lit;
-    EXPECT_LT(std::fabs(mean - expected), test::normalQuantileUpper(0.0005 / 3) * se)
+    // Without a roulette this early every lit sample is F Le itself (se = 0): the GPU's float Fresnel
+    // then differs from this CPU value by rounding only (relative 1e-5 is ~100 float ulps).
+    EXPECT_LE(std::fabs(mean - expected), std::max(test::normalQuantileUpper(0.0005 / 3) * se, 1e-5 * expected))
         << "channel " << c << ": mean " << mean << " +- " << se << " vs F Le = " << expected;
   }
   EXPECT_GT(lit, 20);
