@@ -6,6 +6,9 @@
                  on purpose (the loader must drop them: 64 of 1024).
   mis.gltf       a floor under a large dim and a small bright emissive quad (MIS test).
   punctual.gltf  a floor lit by one point and one spot light (KHR_lights_punctual).
+  combined.gltf  combined materials (NUSSELT_brdf components) in a small coloured box under an
+                 area light: lambert + phong + mirror, lambert + dielectric, a saturated lambert
+                 + a white phong; for renders that exercise every combined-material code path.
 
 Emissive surfaces are one-sided: they emit on the side of their geometric normal
 (v1 - v0) x (v2 - v0), so every triangle here is wound to face where it should emit or be seen.
@@ -114,6 +117,12 @@ class Builder:
         if strength is not None:
             self.use("KHR_materials_emissive_strength")
             mat["extensions"]["KHR_materials_emissive_strength"] = {"emissiveStrength": strength}
+        self.doc["materials"].append(mat)
+        return len(self.doc["materials"]) - 1
+
+    def combined_material(self, name, components):
+        self.use("NUSSELT_brdf")
+        mat = {"name": name, "extensions": {"NUSSELT_brdf": {"components": components}}}
         self.doc["materials"].append(mat)
         return len(self.doc["materials"]) - 1
 
@@ -239,7 +248,32 @@ def punctual():
     b.write("punctual.gltf")
 
 
+def combined():
+    b = Builder()
+    tile = b.combined_material("tile", [
+        {"model": "lambert", "weight": 0.6, "params": {"rho": [0.5, 0.4, 0.3]}},
+        {"model": "phong", "params": {"kd": 0, "ks": 0.3, "n": 50}},
+        {"model": "mirror", "weight": 0.2, "params": {"eta": 0.96, "k": 6.69}}])
+    glazed = b.combined_material("glazed", [
+        {"model": "lambert", "weight": 0.5, "params": {"rho": [0.2, 0.6, 0.2]}},
+        {"model": "dielectric", "weight": 0.5, "params": {"eta": 1.5}}])
+    red = b.combined_material("red_gloss", [
+        {"model": "lambert", "params": {"rho": [0.57, 0.043, 0.044]}},
+        {"model": "phong", "params": {"kd": 0, "ks": 0.2, "n": 200}}])
+    white = b.material("white", 0.7)
+    light = b.material("light", 0.0, emission=(1.0, 1.0, 1.0), strength=10.0)
+    b.quad("floor", [[-1, 0, -1], [-1, 0, 1], [1, 0, 1], [1, 0, -1]], tile)
+    b.quad("back", [[-1, 0, -1], [1, 0, -1], [1, 2, -1], [-1, 2, -1]], glazed)
+    b.quad("left", [[-1, 0, 1], [-1, 0, -1], [-1, 2, -1], [-1, 2, 1]], red)
+    b.quad("right", [[1, 0, -1], [1, 0, 1], [1, 2, 1], [1, 2, -1]], white)
+    b.quad("ceiling", [[-1, 2, -1], [1, 2, -1], [1, 2, 1], [-1, 2, 1]], white)
+    b.quad("light", [[-0.3, 1.99, -0.3], [0.3, 1.99, -0.3], [0.3, 1.99, 0.3], [-0.3, 1.99, 0.3]], light)
+    b.camera("camera", (0.0, 1.0, 3.4), (0.0, 1.0, 0.0), 0.8, 1.0)
+    b.write("combined.gltf")
+
+
 if __name__ == "__main__":
     furnace()
     mis()
     punctual()
+    combined()

@@ -14,13 +14,6 @@ namespace nusselt {
 extern const unsigned char kDefaultSceneBytes[];
 extern const std::size_t kDefaultSceneSize;
 
-std::atomic<int> g_stopSignal{0};
-
-void onStopSignal(int sig) {
-  g_stopSignal.store(sig);
-  std::signal(sig, SIG_DFL);  // a second signal ends the program at once
-}
-
 bool validationFromEnvironment() {
   const char* v = std::getenv("NUSSELT_VALIDATION");
   return v && *v && std::string(v) != "0";

@@ -1,17 +1,13 @@
-// cli_common.h: what the commands share: the stop signal, the validation switch, output-path
-// checks and the scene (a file or the built-in Cornell box).
+// cli_common.h: what the commands share: the validation switch, output-path checks and the scene
+// (a file or the built-in Cornell box). The stop signal is in util/stop_signal.h.
 #pragma once
 #include <atomic>
 #include <string>
 
 #include "scene/scene.h"
+#include "util/stop_signal.h"
 
 namespace nusselt {
-
-// The signal (SIGINT, SIGTERM) that asked a long-running command to stop, or 0. Install
-// onStopSignal for both; a second signal ends the program at once.
-extern std::atomic<int> g_stopSignal;
-void onStopSignal(int sig);
 
 // NUSSELT_VALIDATION set to anything but "" or "0".
 bool validationFromEnvironment();

@@ -17,10 +17,12 @@
 #include "cli/cli_common.h"
 #include "io/image.h"
 #include "quadtree/sampler_tables.h"
+#include "render/render_loop.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
 #include "util/progress.h"
+#include "util/stop_signal.h"
 #include "vk/vk.h"
 
 namespace nusselt {
@@ -49,98 +51,12 @@ struct RenderArgs {
   bool quiet = false;
   float exposure = 0.0f;
   double checkpointSeconds = 120;
-};
-
-// What a render records in its EXR header (and what --resume and merge check and carry on).
-struct RenderRecord {
-  std::string scene;
-  std::string device;
-  std::string models;
-  RenderSettings settings;
-  std::uint32_t spp = 0;
-  bool interrupted = false;
-  bool checkpoint = false;  // written during the render (periodic checkpoint), not at its end
-  RenderStats stats;
-  std::uint64_t droppedTriangles = 0;
-  double renderSeconds = 0;
-  double totalSeconds = 0;
+  double timeBudget = 0;
+  bool sppGiven = false;
 };
 
 LightingMode parseLighting(const std::string& name) {
   return name == "nee" ? LightingMode::NeeOnly : name == "bsdf" ? LightingMode::BsdfOnly : LightingMode::Mis;
-}
-
-ImageMetadata makeMetadata(const RenderRecord& r) {
-  ImageMetadata meta;
-  meta.strings = {{"nusselt/version", NUSSELT_VERSION},
-                  {"nusselt/scene", r.scene},
-                  {"nusselt/device", r.device},
-                  {"nusselt/integrator", std::string("wavefront path tracer: NEE + BSDF sampling, MIS power "
-                                         "heuristic, ") + rouletteModeName(r.settings.roulette) + " Russian roulette"},
-                  {"nusselt/roulette", rouletteModeName(r.settings.roulette)},
-                  {"nusselt/lighting", lightingModeName(r.settings.lighting)},
-                  {"nusselt/rng", rngModeName(r.settings.rng)},
-                  {"nusselt/sampler", samplerName(r.settings.sampler)},
-                  {"nusselt/components", componentSelectionName(r.settings.components)},
-                  {"nusselt/models", r.models}};
-  meta.ints = {{"nusselt/spp", r.spp},
-               {"nusselt/sppOffset", r.settings.sampleOffset},
-               {"nusselt/seed", r.settings.seed},
-               {"nusselt/maxDepth", r.settings.maxDepth},
-               {"nusselt/interrupted", r.interrupted ? 1 : 0},
-               {"nusselt/checkpoint", r.checkpoint ? 1 : 0},
-               {"nusselt/rays", static_cast<std::int64_t>(r.stats.rays)},
-               {"nusselt/shadowRays", static_cast<std::int64_t>(r.stats.shadowRays)},
-               {"nusselt/nonFiniteSamples", static_cast<std::int64_t>(r.stats.nonFiniteSamples)},
-               {"nusselt/bvhStackOverflows", static_cast<std::int64_t>(r.stats.bvhStackOverflows)},
-               {"nusselt/samplerBoundViolations", static_cast<std::int64_t>(r.stats.samplerBoundViolations)},
-               {"nusselt/samplerTrialFailures", static_cast<std::int64_t>(r.stats.samplerTrialFailures)},
-               {"nusselt/droppedTriangles", static_cast<std::int64_t>(r.droppedTriangles)}};
-  meta.doubles = {{"nusselt/renderSeconds", r.renderSeconds}, {"nusselt/totalSeconds", r.totalSeconds}};
-  return meta;
-}
-
-// Reads back what makeMetadata wrote; throws naming the file and the attribute when one is missing.
-RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
-  auto str = [&](const char* name) {
-    auto v = findString(meta, name);
-    if (!v) throw Error(path + ": header attribute " + name + " is missing (not written by nusselt?)");
-    return *v;
-  };
-  auto num = [&](const char* name) {
-    auto v = findInt(meta, name);
-    if (!v || *v < 0) throw Error(path + ": header attribute " + name + " is missing or negative");
-    return *v;
-  };
-  RenderRecord r;
-  r.scene = str("nusselt/scene");
-  r.device = str("nusselt/device");
-  r.models = str("nusselt/models");
-  std::string lighting = str("nusselt/lighting");
-  r.settings.lighting = parseLighting(lighting);
-  r.settings.rng = findString(meta, "nusselt/rng").value_or("pcg") == "qmc" ? RngMode::Qmc : RngMode::Pcg;
-  if (!parseSampler(str("nusselt/sampler"), r.settings.sampler))
-    throw Error(path + ": header attribute nusselt/sampler names an unknown sampler");
-  // Absent in files written before combined materials existed: those rendered in albedo mode.
-  if (!parseComponentSelection(findString(meta, "nusselt/components").value_or("albedo"), r.settings.components))
-    throw Error(path + ": header attribute nusselt/components names an unknown component selection");
-  // Absent in files written before the throughput roulette existed: those used the albedo roulette.
-  if (!parseRouletteMode(findString(meta, "nusselt/roulette").value_or("albedo"), r.settings.roulette))
-    throw Error(path + ": header attribute nusselt/roulette names an unknown roulette");
-  r.spp = static_cast<std::uint32_t>(num("nusselt/spp"));
-  r.settings.sampleOffset = static_cast<std::uint32_t>(num("nusselt/sppOffset"));
-  r.settings.seed = static_cast<std::uint32_t>(num("nusselt/seed"));
-  r.settings.maxDepth = static_cast<std::uint32_t>(num("nusselt/maxDepth"));
-  r.stats.rays = num("nusselt/rays");
-  r.stats.shadowRays = num("nusselt/shadowRays");
-  r.stats.nonFiniteSamples = num("nusselt/nonFiniteSamples");
-  r.stats.bvhStackOverflows = num("nusselt/bvhStackOverflows");
-  r.stats.samplerBoundViolations = num("nusselt/samplerBoundViolations");
-  r.stats.samplerTrialFailures = num("nusselt/samplerTrialFailures");
-  r.droppedTriangles = num("nusselt/droppedTriangles");
-  r.renderSeconds = findDouble(meta, "nusselt/renderSeconds").value_or(0);
-  r.totalSeconds = findDouble(meta, "nusselt/totalSeconds").value_or(0);
-  return r;
 }
 
 int renderCommand(const RenderArgs& a) {
@@ -148,25 +64,15 @@ int renderCommand(const RenderArgs& a) {
   const std::string output = !a.output.empty() ? a.output : !a.resume.empty() ? a.resume : "render.exr";
   checkOutputPath(output, "-o");
   if (!a.png.empty()) checkOutputPath(a.png, "--png");
+  auto t0 = std::chrono::steady_clock::now();
 
   // A signal from here on is handled: before the first pass it just ends without output.
-  g_stopSignal = 0;
-  auto oldInt = std::signal(SIGINT, onStopSignal);
-  auto oldTerm = std::signal(SIGTERM, onStopSignal);
-  struct RestoreSignals {
-    void (*i)(int);
-    void (*t)(int);
-    ~RestoreSignals() {
-      std::signal(SIGINT, i);
-      std::signal(SIGTERM, t);
-    }
-  } restore{oldInt, oldTerm};
+  ScopedStopSignals signals;
 
   Scene scene = loadSceneOrDefault(a.scene, a.camera);
   printSceneWarnings(scene, a.quiet);
 
   RenderSettings s;
-  s.spp = a.spp;
   s.seed = a.seed;
   s.maxDepth = a.maxDepth;
   s.sampleOffset = a.sppOffset;
@@ -179,6 +85,15 @@ int renderCommand(const RenderArgs& a) {
   float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
   s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u);
   s.height = a.height ? a.height : std::max(1u, unsigned(s.width / aspect + 0.5f));
+  // The samples to take: --spp, or without it and with --time as many as the budget allows.
+  const std::uint32_t targetSpp = a.timeBudget > 0 && !a.sppGiven ? (1u << 30) : a.spp;
+  s.spp = targetSpp;
+
+  RenderRecord base;
+  base.scene = scene.sourcePath;
+  base.settings = s;
+  base.camera = scene.hasCamera ? scene.camera : frameScene(scene);
+  base.droppedTriangles = scene.droppedTriangles;
 
   // --resume: the saved render must be of this very render (scene and settings), fewer spp.
   Image saved;
@@ -187,25 +102,21 @@ int renderCommand(const RenderArgs& a) {
     ImageMetadata meta;
     saved = readExr(a.resume, &meta);
     previous = readRecord(a.resume, meta);
-    auto mismatch = [&](const std::string& what, const std::string& was, const std::string& now) {
-      if (was != now)
-        throw Error("--resume " + a.resume + ": " + what + " was " + was + ", this render has " + now +
-                    " (a render can only be resumed with the same scene and settings)");
-    };
-    mismatch("the scene", previous.scene, scene.sourcePath);
-    mismatch("the image size", std::to_string(saved.width) + "x" + std::to_string(saved.height),
-             std::to_string(s.width) + "x" + std::to_string(s.height));
-    mismatch("--seed", std::to_string(previous.settings.seed), std::to_string(s.seed));
-    mismatch("--max-depth", std::to_string(previous.settings.maxDepth), std::to_string(s.maxDepth));
-    mismatch("--lighting", lightingModeName(previous.settings.lighting), lightingModeName(s.lighting));
-    mismatch("--rng", rngModeName(previous.settings.rng), rngModeName(s.rng));
-    mismatch("--sampler", samplerName(previous.settings.sampler), samplerName(s.sampler));
-    mismatch("--components", componentSelectionName(previous.settings.components), componentSelectionName(s.components));
-    mismatch("--roulette", rouletteModeName(previous.settings.roulette), rouletteModeName(s.roulette));
-    mismatch("--spp-offset", std::to_string(previous.settings.sampleOffset), std::to_string(s.sampleOffset));
+    previous.settings.width = static_cast<std::uint32_t>(saved.width);
+    previous.settings.height = static_cast<std::uint32_t>(saved.height);
+    // A render resumes at the view it was rendered from (a preview's save may have moved it).
+    if (previous.cameraRecorded) base.camera = previous.camera;
+    else previous.camera = base.camera;
+    const std::string d = firstDifference(previous, base);
+    if (!d.empty())
+      throw Error("--resume " + a.resume + ": " + d + " (saved vs this render; a render can only be resumed with the "
+                  "same scene and settings)");
+    if (previous.settings.sampleOffset != s.sampleOffset)
+      throw Error("--resume " + a.resume + ": --spp-offset was " + std::to_string(previous.settings.sampleOffset) +
+                  ", this render has " + std::to_string(s.sampleOffset));
     if (saved.sum.empty() || saved.sumSq.empty())
       throw Error("--resume " + a.resume + ": no accumulation channels (sum.R/G/B, sumSq.R/G/B)");
-    if (previous.spp >= s.spp)
+    if (previous.spp >= targetSpp)
       throw Error("--resume " + a.resume + ": it already has " + std::to_string(previous.spp) +
                   " spp; ask for more with --spp (the total)");
   }
@@ -217,15 +128,18 @@ int renderCommand(const RenderArgs& a) {
   vk::createContext(ctx, co);
   int status = kExitOk;
   {
-    auto t0 = std::chrono::steady_clock::now();
     if (!a.quiet && s.sampler == SamplerKind::Quadtree)
       std::fprintf(stderr, "sampler: building or loading the quadtrees of the scene's materials (cached in %s; "
                            "a first build can take minutes for some models, see docs/sampler.md)\n",
                    quadtree::cacheDirectory().empty() ? "no writable directory" : quadtree::cacheDirectory().c_str());
     Renderer renderer(ctx, scene, s);
+    renderer.setCamera(base.camera);
     const SceneSummary& sum = renderer.summary();
     std::string models;
     for (auto& m : sum.models) models += (models.empty() ? "" : ",") + m;
+    base.device = ctx.deviceName;
+    base.driver = ctx.driverInfo;
+    base.models = models;
     if (!a.resume.empty()) {
       if (previous.device != ctx.deviceName && !a.quiet)
         std::fprintf(stderr, "warning: %s was rendered on %s; continuing on %s (not bit-identical to an uninterrupted render)\n",
@@ -244,75 +158,33 @@ int renderCommand(const RenderArgs& a) {
         std::fprintf(stderr, "sampler: %u quadtrees (%.1f MiB) in %.2f s (cache: %u hits, %u built, %u rejected)\n",
                      sum.samplerTrees, sum.samplerBytes / 1048576.0, sum.samplerSeconds, sum.samplerCacheHits,
                      sum.samplerCacheMisses, sum.samplerCacheRejected);
-      std::fprintf(stderr, "device: %s; %ux%u, %u spp%s, max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
+      std::string budget = a.timeBudget > 0 ? ", time budget " + std::to_string(a.timeBudget) + " s" : "";
+      std::fprintf(stderr, "device: %s (%s); %ux%u, %s spp%s%s, max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
                            "roulette %s\n",
-                   ctx.deviceName.c_str(), s.width, s.height, s.spp,
+                   ctx.deviceName.c_str(), ctx.driverInfo.c_str(), s.width, s.height,
+                   targetSpp == (1u << 30) ? "unlimited" : std::to_string(targetSpp).c_str(),
                    a.resume.empty() ? "" : (" (resuming from " + std::to_string(previous.spp) + ")").c_str(),
-                   s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng), samplerName(s.sampler),
-                   rouletteModeName(s.roulette));
+                   budget.c_str(), s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng),
+                   samplerName(s.sampler), rouletteModeName(s.roulette));
     }
 
-    auto tRender = std::chrono::steady_clock::now();
-    // What the header says about this render at any moment (checkpoints and the final image).
-    auto record = [&](bool checkpoint) {
-      RenderRecord r;
-      r.scene = scene.sourcePath;
-      r.device = ctx.deviceName;
-      r.models = models;
-      r.settings = s;
-      r.spp = renderer.samplesDone();
-      r.interrupted = g_stopSignal != 0;
-      r.checkpoint = checkpoint;
-      r.stats = renderer.stats();
-      r.droppedTriangles = scene.droppedTriangles;
-      double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - tRender).count();
-      r.renderSeconds = previous.renderSeconds + now;
-      r.totalSeconds = previous.totalSeconds + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      return r;
-    };
-    std::uint32_t checkpointSpp = 0;
-    {
-      Progress progress("render", s.spp, std::uint64_t(s.width) * s.height, false, a.quiet);
-      progress.update(renderer.samplesDone());
-      auto lastCheckpoint = std::chrono::steady_clock::now();
-      try {
-        while (renderer.samplesDone() < s.spp && g_stopSignal == 0) {
-          renderer.renderPass();
-          progress.update(renderer.samplesDone());
-          // A periodic checkpoint: the output file always holds a resumable image, so a crash,
-          // a power cut or a lost device loses at most one interval of work.
-          if (a.checkpointSeconds > 0 && renderer.samplesDone() < s.spp &&
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - lastCheckpoint).count() >= a.checkpointSeconds) {
-            writeExr(output, renderer.image(a.variance), makeMetadata(record(true)));
-            checkpointSpp = renderer.samplesDone();
-            lastCheckpoint = std::chrono::steady_clock::now();
-          }
-        }
-      } catch (const Error& e) {
-        // The device was lost or ran out of memory mid-render: its film cannot be read any more.
-        std::string saved = checkpointSpp > 0
-                                ? "; the last checkpoint (" + std::to_string(checkpointSpp) + " spp) is in " + output +
-                                      ": continue with --resume " + output
-                                : previous.spp > 0 ? "; " + a.resume + " still holds its " + std::to_string(previous.spp) + " spp"
-                                                   : "; no checkpoint had been written yet (see --checkpoint)";
-        throw Error(std::string(e.what()) + " after " + std::to_string(renderer.samplesDone()) + " spp" + saved);
-      }
-      double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - tRender).count();
-      RenderStats st = renderer.stats();
-      char extra[256];
-      std::snprintf(extra, sizeof extra, "%.2f Mrays/s",
-                    (st.rays + st.shadowRays - previous.stats.rays - previous.stats.shadowRays) / 1e6 / std::max(1e-9, sec));
-      progress.finish(extra);
-    }
-    RenderRecord rec = record(false);
+    base.totalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();  // set-up
+    RenderLoopOptions lo;
+    lo.spp = targetSpp;
+    lo.timeBudget = a.timeBudget;
+    lo.checkpointSeconds = a.checkpointSeconds;
+    lo.output = output;
+    lo.variance = a.variance;
+    lo.quiet = a.quiet;
+    RenderLoop loop(renderer, base, previous, lo);
+    loop.run();
+    RenderRecord rec = loop.record(false);
     if (rec.interrupted)
       std::fprintf(stderr, "interrupted by %s after %u of %u spp: writing what has accumulated\n",
-                   g_stopSignal == SIGINT ? "SIGINT" : "SIGTERM", rec.spp, s.spp);
+                   g_stopSignal == SIGINT ? "SIGINT" : "SIGTERM", rec.spp, targetSpp);
 
     if (rec.spp > previous.spp) {
-      Image img = renderer.image(a.variance);
-      writeExr(output, img, makeMetadata(rec));
-      if (!a.png.empty()) writePng(a.png, img, a.exposure);
+      loop.write(output, false, a.png, a.exposure);
       if (!a.quiet) {
         std::fprintf(stderr, "wrote %s (%u spp)%s%s\n", output.c_str(), rec.spp, a.png.empty() ? "" : " and ",
                      a.png.c_str());
@@ -349,29 +221,23 @@ int mergeCommand(const std::vector<std::string>& inputs, const std::string& outp
     ImageMetadata meta;
     Image img = readExr(inputs[k], &meta);
     RenderRecord r = readRecord(inputs[k], meta);
+    r.settings.width = static_cast<std::uint32_t>(img.width);
+    r.settings.height = static_cast<std::uint32_t>(img.height);
     if (img.sum.empty() || img.sumSq.empty())
       throw Error(inputs[k] + ": no accumulation channels (sum.R/G/B, sumSq.R/G/B): not a nusselt render");
     if (k == 0) {
       total = img;
       merged = r;
+      merged.source = "merge";
       merged.spp = 0;
       merged.stats = RenderStats{};
       merged.renderSeconds = merged.totalSeconds = 0;
     } else {
-      auto same = [&](const std::string& what, const std::string& a, const std::string& b) {
-        if (a != b) throw Error(inputs[k] + ": " + what + " is " + b + " but " + inputs[0] + " has " + a);
-      };
-      same("the image size", std::to_string(total.width) + "x" + std::to_string(total.height),
-           std::to_string(img.width) + "x" + std::to_string(img.height));
-      same("the scene", merged.scene, r.scene);
-      same("the seed", std::to_string(merged.settings.seed), std::to_string(r.settings.seed));
-      same("the max depth", std::to_string(merged.settings.maxDepth), std::to_string(r.settings.maxDepth));
-      same("the lighting", lightingModeName(merged.settings.lighting), lightingModeName(r.settings.lighting));
-      same("the random numbers", rngModeName(merged.settings.rng), rngModeName(r.settings.rng));
-      same("the sampler", samplerName(merged.settings.sampler), samplerName(r.settings.sampler));
-      same("the component selection", componentSelectionName(merged.settings.components),
-           componentSelectionName(r.settings.components));
-      same("the roulette", rouletteModeName(merged.settings.roulette), rouletteModeName(r.settings.roulette));
+      // Files that predate the camera record were rendered from their scene's camera: equal.
+      if (!r.cameraRecorded || !merged.cameraRecorded) r.camera = merged.camera;
+      const std::string d = firstDifference(merged, r);
+      if (!d.empty()) throw Error(inputs[k] + ": " + d + " (" + inputs[0] + " vs this file): only renders of the same "
+                                  "scene and settings can be merged");
       for (std::size_t i = 0; i < total.sum.size(); ++i) {
         total.sum[i] += img.sum[i];
         total.sumSq[i] += img.sumSq[i];
@@ -395,14 +261,7 @@ int mergeCommand(const std::vector<std::string>& inputs, const std::string& outp
     merged.renderSeconds += r.renderSeconds;
     merged.totalSeconds += r.totalSeconds;
   }
-  const float n = float(merged.spp);
-  total.variance.assign(total.sum.size(), 0.0f);
-  for (std::size_t i = 0; i < total.sum.size(); ++i) {
-    float mean = total.sum[i] / n;
-    total.rgb[i] = mean;
-    double var = n > 1 ? (double(total.sumSq[i]) - double(n) * mean * mean) / (double(n) - 1.0) : 0.0;
-    total.variance[i] = static_cast<float>(std::max(var, 0.0) / n);
-  }
+  Film::resolve(total, float(merged.spp), true);
   writeExr(output, total, makeMetadata(merged));
   std::fprintf(stderr, "merged %zu renders into %s (%u spp)\n", inputs.size(), output.c_str(), merged.spp);
   return kExitOk;
@@ -415,9 +274,9 @@ int devicesCommand() {
     return kExitFailure;
   }
   for (const auto& d : devices)
-    std::printf("%u: %s (%s, Vulkan %u.%u, %.0f MiB device-local)%s%s\n", d.index, d.name.c_str(), d.type.c_str(),
-                VK_API_VERSION_MAJOR(d.apiVersion), VK_API_VERSION_MINOR(d.apiVersion),
-                d.deviceLocalBytes / 1048576.0, d.suitable ? "" : ": not usable: ", d.whyNot.c_str());
+    std::printf("%u: %s (%s, Vulkan %u.%u, driver %s, %.0f MiB device-local)%s%s\n", d.index, d.name.c_str(),
+                d.type.c_str(), VK_API_VERSION_MAJOR(d.apiVersion), VK_API_VERSION_MINOR(d.apiVersion),
+                d.driverInfo.c_str(), d.deviceLocalBytes / 1048576.0, d.suitable ? "" : ": not usable: ", d.whyNot.c_str());
   return kExitOk;
 }
 
@@ -595,7 +454,12 @@ int runCli(int argc, char** argv) {
   CLI::App* render = app.add_subcommand("render", "Render a glTF scene (default: the built-in Cornell box) to OpenEXR");
   render->add_option("scene", ra.scene, "glTF 2.0 scene (.gltf or .glb); omitted: the built-in Cornell box");
   render->add_option("-o,--output", ra.output, "Output OpenEXR file (32-bit float RGB; default render.exr, or the --resume file)");
-  render->add_option("--spp", ra.spp, "Samples per pixel")->capture_default_str()->check(CLI::Range(0u, 1u << 30));
+  CLI::Option* sppOption =
+      render->add_option("--spp", ra.spp, "Samples per pixel (with --time: at most this many)")->capture_default_str()
+          ->check(CLI::Range(0u, 1u << 30));
+  render->add_option("--time", ra.timeBudget, "Time budget in seconds: stop at the first pass boundary after it and "
+                                              "write the image with its true spp (--spp, if given, still caps it)")
+      ->check(CLI::Range(0.0, 1e9));
   render->add_option("--width", ra.width, "Image width in pixels (default 512, or from --height and the camera's aspect ratio)")
       ->check(CLI::Range(1u, 65536u));
   render->add_option("--height", ra.height, "Image height in pixels (default from the width and the camera's aspect ratio)")
@@ -695,7 +559,10 @@ int runCli(int argc, char** argv) {
   }
   try {
     if (run) return run();
-    if (*render) return renderCommand(ra);
+    if (*render) {
+      ra.sppGiven = sppOption->count() > 0;
+      return renderCommand(ra);
+    }
     if (*devices) return devicesCommand();
     if (*benchRender) return benchRenderCommand(ba);
     if (*benchPipelines) return benchPipelinesCommand(pipelinesDevice);

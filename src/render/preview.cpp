@@ -33,6 +33,7 @@
 #include "cli/cli_common.h"
 #include "cli/commands.h"
 #include "io/image.h"
+#include "render/render_loop.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
@@ -232,6 +233,8 @@ class Preview {
 
  private:
   void createRenderer(std::uint32_t width, std::uint32_t height);
+  // A new render loop over the renderer's film (after any restart of accumulation).
+  void restartLoop();
   bool createSwapchain();  // false: the surface has no area (minimised); try later
   void destroySwapchain();
   bool presentFrame();  // false: the swapchain must be recreated
@@ -239,7 +242,6 @@ class Preview {
   void onKey(int key, int mods);
   void cameraChanged() { m_cameraDirty = true; }
   void save();
-  ImageMetadata metadata() const;
   void writeScreenshot(const std::string& path);
   void destroy();
 
@@ -264,6 +266,7 @@ class Preview {
   VkSurfaceKHR m_surface = VK_NULL_HANDLE;
 
   std::unique_ptr<Renderer> m_renderer;
+  std::unique_ptr<RenderLoop> m_loop;
   vk::ComputePipeline m_display;
   vk::Buffer m_displayBuffer;
 
@@ -280,7 +283,8 @@ class Preview {
   Orbit m_orbit;
   bool m_cameraDirty = false;
   bool m_displayDirty = true;
-  bool m_lightingDirty = false;
+  bool m_lightingDirty = false;  // a new lighting estimator: setLighting (no pipeline is rebuilt)
+  bool m_samplerDirty = false;   // a new sampling strategy: the shade stages are specialised, a new Renderer
   bool m_paused = false;
   bool m_reinhard = false;
   float m_exposure = 0.0f;
@@ -360,7 +364,7 @@ void Preview::onKey(int key, int mods) {
           if (m_sampler != name) {
             m_sampler = name;
             parseSampler(m_sampler, m_settings.sampler);
-            m_lightingDirty = true;  // recreate the renderer with the new strategy
+            m_samplerDirty = true;  // recreate the renderer with the new strategy
           }
           break;
         }
@@ -382,7 +386,7 @@ void Preview::onKey(int key, int mods) {
     } else if (m_sampler != s.name) {
       m_sampler = s.name;
       parseSampler(m_sampler, m_settings.sampler);
-      m_lightingDirty = true;  // recreate the renderer with the new strategy
+      m_samplerDirty = true;  // recreate the renderer with the new strategy
       std::fprintf(stderr, "sampler: %s\n", s.name);
     }
     updateTitle(true);
@@ -395,6 +399,7 @@ void Preview::createRenderer(std::uint32_t width, std::uint32_t height) {
   if (m_renderer) {
     vkDeviceWaitIdle(m_ctx.device);
     vk::destroyComputePipeline(m_ctx, m_display);
+    m_loop.reset();
     m_renderer.reset();
   }
   vk::destroyBuffer(m_ctx, m_displayBuffer);
@@ -406,6 +411,25 @@ void Preview::createRenderer(std::uint32_t width, std::uint32_t height) {
   m_displayBuffer = vk::createBuffer(m_ctx, VkDeviceSize(width) * height * 4, 0, false, "display");
   m_renderer->setDisplayBuffer(m_displayBuffer.address);
   m_displayDirty = true;
+  restartLoop();
+}
+
+void Preview::restartLoop() {
+  RenderRecord base;
+  base.scene = m_scene.sourcePath;
+  base.device = m_ctx.deviceName;
+  base.driver = m_ctx.driverInfo;
+  for (const std::string& m : m_renderer->summary().models) base.models += (base.models.empty() ? "" : ",") + m;
+  base.source = "preview";
+  base.settings = m_settings;
+  base.camera = m_renderer->camera();
+  base.droppedTriangles = m_scene.droppedTriangles;
+  RenderLoopOptions lo;
+  lo.spp = m_args.maxSpp ? m_args.maxSpp : (1u << 30);
+  lo.progress = false;
+  lo.quiet = true;
+  m_loop.reset();
+  m_loop = std::make_unique<RenderLoop>(*m_renderer, base, RenderRecord{}, lo);
 }
 
 bool Preview::createSwapchain() {
@@ -597,32 +621,6 @@ void Preview::updateTitle(bool force) {
   glfwSetWindowTitle(m_window, title);
 }
 
-ImageMetadata Preview::metadata() const {
-  ImageMetadata meta;
-  std::string models;
-  for (auto& x : m_renderer->summary().models) models += (models.empty() ? "" : ",") + x;
-  RenderStats st = m_renderer->stats();
-  meta.strings = {{"nusselt/version", NUSSELT_VERSION},
-                  {"nusselt/scene", m_scene.sourcePath},
-                  {"nusselt/device", m_ctx.deviceName},
-                  {"nusselt/integrator", "wavefront path tracer: NEE + BSDF sampling, MIS power heuristic, "
-                                         "albedo Russian roulette"},
-                  {"nusselt/lighting", lightingModeName(m_settings.lighting)},
-                  {"nusselt/sampler", m_sampler},
-                  {"nusselt/models", models},
-                  {"nusselt/source", "preview"}};
-  meta.ints = {{"nusselt/spp", m_renderer->samplesDone()},
-               {"nusselt/seed", m_settings.seed},
-               {"nusselt/maxDepth", m_settings.maxDepth},
-               {"nusselt/nonFiniteSamples", static_cast<std::int64_t>(st.nonFiniteSamples)},
-               {"nusselt/samplerBoundViolations", static_cast<std::int64_t>(st.samplerBoundViolations)},
-               {"nusselt/samplerTrialFailures", static_cast<std::int64_t>(st.samplerTrialFailures)},
-               {"nusselt/droppedTriangles", static_cast<std::int64_t>(m_scene.droppedTriangles)}};
-  meta.doubles = {{"nusselt/exposure", m_exposure},
-                  {"nusselt/totalSeconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count()}};
-  return meta;
-}
-
 void Preview::save() {
   if (!m_renderer || m_renderer->samplesDone() == 0) {
     std::fprintf(stderr, "nothing to save yet (0 spp)\n");
@@ -636,9 +634,9 @@ void Preview::save() {
     if (!fs::exists(base + ".exr", ec) && !fs::exists(base + ".png", ec)) break;
   }
   try {
-    Image img = m_renderer->image(false);
-    writeExr(base + ".exr", img, metadata());
-    writePng(base + ".png", img, m_exposure);  // clamp tone map, as `nusselt render --png`
+    // The full record of a render: `nusselt render --resume` continues it, `nusselt merge` adds it.
+    m_loop->setDisplayExposure(m_exposure);
+    m_loop->write(base + ".exr", false, base + ".png", m_exposure);  // clamp tone map, as `render --png`
     std::fprintf(stderr, "wrote %s.exr and %s.png (%u spp)\n", base.c_str(), base.c_str(), m_renderer->samplesDone());
   } catch (const Error& e) {
     std::fprintf(stderr, "error: saving failed: %s\n", e.what());  // the preview goes on
@@ -762,13 +760,12 @@ int Preview::run() {
                  lightingModeName(m_settings.lighting), m_sampler.c_str());
   }
 
-  g_stopSignal = 0;
-  auto oldInt = std::signal(SIGINT, onStopSignal);
-  auto oldTerm = std::signal(SIGTERM, onStopSignal);
+  std::unique_ptr<ScopedStopSignals> signals = std::make_unique<ScopedStopSignals>();
   std::size_t nextResize = 0, nextKey = 0;
   bool swapchainStale = false;
   while (!glfwWindowShouldClose(m_window) && g_stopSignal == 0) {
-    bool idle = m_paused || (a.maxSpp && m_renderer->samplesDone() >= a.maxSpp && !m_cameraDirty && !m_lightingDirty);
+    const bool dirty = m_cameraDirty || m_lightingDirty || m_samplerDirty;
+    bool idle = m_paused || (a.maxSpp && m_renderer->samplesDone() >= a.maxSpp && !dirty);
     // Test harness: one key per frame from the second frame on, as if typed (also while idle).
     if (nextKey < keys.size() && (idle || m_framesPresented >= 1 + nextKey)) {
       onKey(keys[nextKey].first, keys[nextKey].second);
@@ -777,8 +774,8 @@ int Preview::run() {
     }
     const bool minimised = glfwGetWindowAttrib(m_window, GLFW_ICONIFIED) != 0;
     // Scripts: once --max-spp is reached nothing changes any more, so --frames ends the run.
-    if (a.frames && a.maxSpp && m_renderer->samplesDone() >= a.maxSpp && !m_cameraDirty && !m_lightingDirty &&
-        !m_displayDirty && nextKey >= keys.size())
+    if (a.frames && a.maxSpp && m_renderer->samplesDone() >= a.maxSpp && !dirty && !m_displayDirty &&
+        nextKey >= keys.size())
       break;
     if (minimised || (idle && !m_displayDirty && !swapchainStale)) {
       glfwWaitEventsTimeout(0.25);  // nothing to draw: sleep until something happens
@@ -813,20 +810,27 @@ int Preview::run() {
       }
       swapchainStale = false;
     }
-    if (m_lightingDirty) {
+    if (m_samplerDirty) {
       createRenderer(m_settings.width, m_settings.height);  // keeps the camera; restarts accumulation
+      m_samplerDirty = m_lightingDirty = false;
+    }
+    if (m_lightingDirty) {
+      m_renderer->setLighting(m_settings.lighting);  // a run-time value of the shaders; restarts accumulation
       m_lightingDirty = false;
+      restartLoop();
     }
     if (m_cameraDirty) {
       m_renderer->setCamera(m_orbit.cam);
       m_cameraDirty = false;
+      restartLoop();
     }
-    if (!m_paused && !(a.maxSpp && m_renderer->samplesDone() >= a.maxSpp)) {
+    if (!m_paused) {
       auto t0 = std::chrono::steady_clock::now();
-      m_renderer->renderPass();
-      double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      double rate = double(m_settings.width) * m_settings.height / std::max(sec, 1e-9);
-      m_samplesPerSecond = m_samplesPerSecond > 0 ? 0.8 * m_samplesPerSecond + 0.2 * rate : rate;
+      if (m_loop->step()) {
+        double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        double rate = double(m_settings.width) * m_settings.height / std::max(sec, 1e-9);
+        m_samplesPerSecond = m_samplesPerSecond > 0 ? 0.8 * m_samplesPerSecond + 0.2 * rate : rate;
+      }
     }
     if (!presentFrame()) {
       swapchainStale = true;
@@ -835,9 +839,8 @@ int Preview::run() {
     updateTitle(false);
     if (a.frames && m_framesPresented >= a.frames) break;
   }
-  std::signal(SIGINT, oldInt);
-  std::signal(SIGTERM, oldTerm);
   const int sig = g_stopSignal.load();
+  signals.reset();
   vkDeviceWaitIdle(m_ctx.device);
 
   if (!a.screenshot.empty()) {
@@ -846,7 +849,8 @@ int Preview::run() {
   }
   if (!a.exr.empty()) {
     if (m_renderer->samplesDone() == 0) throw Error("--exr " + a.exr + ": no sample was accumulated");
-    writeExr(a.exr, m_renderer->image(false), metadata());
+    m_loop->setDisplayExposure(m_exposure);
+    m_loop->write(a.exr);
     if (!a.quiet) std::fprintf(stderr, "wrote %s (%u spp)\n", a.exr.c_str(), m_renderer->samplesDone());
   }
   if (!a.quiet)
@@ -870,6 +874,7 @@ void Preview::destroy() {
     vkDeviceWaitIdle(m_ctx.device);
     destroySwapchain();
     if (m_renderer) vk::destroyComputePipeline(m_ctx, m_display);
+    m_loop.reset();
     m_renderer.reset();
     vk::destroyBuffer(m_ctx, m_displayBuffer);
     if (m_cmd) vkFreeCommandBuffers(m_ctx.device, m_ctx.commandPool, 1, &m_cmd);

@@ -30,6 +30,8 @@ struct Material {
   std::vector<MaterialComponent> components;
 
   bool combined() const { return !components.empty(); }
+  // Emits light (any channel of the emission above zero): the material's triangles are lights.
+  bool emits() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
 };
 
 enum class LightType { Point, Spot, Directional };

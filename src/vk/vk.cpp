@@ -172,9 +172,12 @@ DeviceInfo describe(VkPhysicalDevice pd, std::uint32_t index, std::uint32_t* que
     return info;
   }
   VkPhysicalDeviceSubgroupProperties sub{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+  VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+  sub.pNext = &driver;
   VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
   p2.pNext = &sub;
   vkGetPhysicalDeviceProperties2(pd, &p2);
+  info.driverInfo = std::string(driver.driverName) + (driver.driverInfo[0] ? std::string(" ") + driver.driverInfo : "");
   VkSubgroupFeatureFlags need = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT;
   if (!(sub.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) || (sub.supportedOperations & need) != need) {
     info.whyNot = "lacks subgroup ballot in compute shaders";
@@ -281,6 +284,18 @@ void createContext(Context& ctx, const ContextOptions& options) {
   vkGetPhysicalDeviceProperties(ctx.physical, &ctx.properties);
   vkGetPhysicalDeviceMemoryProperties(ctx.physical, &ctx.memory);
   ctx.deviceName = ctx.properties.deviceName;
+  {
+    // The driver (lavapipe's Mesa version matters: 25 is 3-4x faster than 22.3) and the largest
+    // single allocation (2 GiB on lavapipe, which crashes instead of failing when asked for more).
+    VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceMaintenance3Properties m3{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES};
+    m3.pNext = &driver;
+    VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    p2.pNext = &m3;
+    vkGetPhysicalDeviceProperties2(ctx.physical, &p2);
+    ctx.driverInfo = std::string(driver.driverName) + (driver.driverInfo[0] ? std::string(" ") + driver.driverInfo : "");
+    ctx.maxAllocation = m3.maxMemoryAllocationSize;
+  }
 
   float priority = 1.0f;
   VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
@@ -328,6 +343,11 @@ Buffer createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags extraUsa
                     const std::string& what) {
   Buffer b;
   b.size = size < 16 ? 16 : size;
+  // Refuse what the device cannot allocate in one piece, before asking: lavapipe (Mesa 25) crashes
+  // later instead of failing the allocation.
+  if (ctx.maxAllocation && b.size > ctx.maxAllocation)
+    throw Error("the " + what + " buffer needs " + formatBytes(b.size) + " of device memory in one allocation, more "
+                "than " + ctx.deviceName + " allows (" + formatBytes(ctx.maxAllocation) + ")");
   VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   bci.size = b.size;
   bci.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |

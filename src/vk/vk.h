@@ -21,6 +21,7 @@ struct DeviceInfo {
   std::string name;
   std::string type;  // "discrete GPU", "integrated GPU", "CPU", ...
   std::uint32_t apiVersion = 0;
+  std::string driverInfo;  // driver name and version (e.g. "llvmpipe Mesa 25.0.7 (LLVM 15.0.6)")
   bool suitable = false;
   std::string whyNot;  // when not suitable
   std::uint64_t deviceLocalBytes = 0;
@@ -44,6 +45,8 @@ struct Context {
   VkPhysicalDeviceProperties properties{};
   VkPhysicalDeviceMemoryProperties memory{};
   std::string deviceName;
+  std::string driverInfo;         // e.g. "llvmpipe Mesa 25.0.7 (LLVM 15.0.6)": driver name and version
+  VkDeviceSize maxAllocation = 0; // largest single memory allocation (maxMemoryAllocationSize)
   bool validation = false;
   // Validation messages (warnings and errors) seen so far; tests require zero.
   std::atomic<std::uint64_t> validationMessages{0};

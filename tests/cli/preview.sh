@@ -249,5 +249,22 @@ grep -q "sampler: analytic" "$work/keys.out" || fail "key 3 did not switch to th
 "$nusselt" info "$work/keys.exr" | grep -q "nusselt/exposure: 0.5" || fail "] did not raise the exposure by half a stop"
 [ $fails -eq 0 ] && ok "keys: save, lighting, sampler, exposure, tone map"
 
+# ---- Saves are renders: `render --resume` continues a preview save bit for bit, and a moved
+# view resumes at the view that was saved (its camera is in the record) --------------------------
+"$nusselt" preview --width $W --height $H --frames 100 --max-spp 4 --exr "$work/psave.exr" -q || fail "preview save exit $?"
+"$nusselt" render --width $W --height $H --spp 8 --resume "$work/psave.exr" -q || fail "render --resume of a preview save"
+"$nusselt" render --width $W --height $H --spp 8 -o "$work/render8.exr" -q || fail "render --spp 8 exit $?"
+"$nusselt" diff "$work/psave.exr" "$work/render8.exr" | grep -q "max |diff| 0$" &&
+  ok "preview save (4 spp) resumed to 8 spp = headless 8 spp, bit for bit" ||
+  fail "resumed preview save: $("$nusselt" diff "$work/psave.exr" "$work/render8.exr")"
+"$nusselt" preview --width $W --height $H --frames 100 --max-spp 4 --test-keys Left --exr "$work/pmoved.exr" -q ||
+  fail "preview moved save exit $?"
+"$nusselt" preview --width $W --height $H --frames 100 --max-spp 8 --test-keys Left --exr "$work/pmoved8.exr" -q ||
+  fail "preview moved 8 spp exit $?"
+"$nusselt" render --width $W --height $H --spp 8 --resume "$work/pmoved.exr" -q || fail "render --resume of a moved view"
+"$nusselt" diff "$work/pmoved.exr" "$work/pmoved8.exr" | grep -q "max |diff| 0$" &&
+  ok "a moved view resumes at its own camera (= 8 spp of the moved preview)" ||
+  fail "moved view resumed: $("$nusselt" diff "$work/pmoved.exr" "$work/pmoved8.exr")"
+
 [ $fails -eq 0 ] && echo "preview checks pass"
 exit $((fails > 0))

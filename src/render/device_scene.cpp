@@ -1,0 +1,165 @@
+// device_scene.cpp: BVH, triangles, shading data and lights uploaded to the device.
+#include "render/device_scene.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "../../shaders/shared/layout.h"
+#include "scene/bvh.h"
+
+namespace nusselt {
+
+using shared::BvhNode;
+using shared::GpuLight;
+using shared::GpuTriangle;
+using shared::GpuTriShading;
+
+namespace {
+
+glm::vec4 v4(glm::vec3 v, float w = 0.0f) { return glm::vec4(v, w); }
+
+float luminance(glm::vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+}  // namespace
+
+std::uint64_t DeviceScene::bytesFor(std::size_t triangles, std::size_t lights) {
+  // Nodes store both children and leaves are not nodes: fewer nodes than triangles. One light per
+  // emitting triangle or punctual light at most.
+  const std::uint64_t n = std::max<std::size_t>(triangles, 1);
+  return n * sizeof(BvhNode) + n * (sizeof(GpuTriangle) + sizeof(GpuTriShading)) +
+         (std::max<std::size_t>(lights, 1)) * (sizeof(GpuLight) + 4) + 4;
+}
+
+DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene) : m_ctx(ctx), m_background(scene.background) {
+  const std::size_t triCount = scene.triangleCount();
+  m_triangles = triCount;
+
+  // ---- BVH (binned SAH) and triangles in BVH order ----
+  auto t0 = std::chrono::steady_clock::now();
+  Bvh bvh = buildBvh(scene.positions);
+  m_bvhSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  m_bvhNodes = static_cast<std::uint32_t>(bvh.nodes.size());
+
+  // ---- Triangles, shading data and area lights (emitting triangles, by power) ----
+  std::vector<GpuTriangle> tris(std::max<std::size_t>(triCount, 1));
+  std::vector<GpuTriShading> shading(std::max<std::size_t>(triCount, 1));
+  std::vector<GpuLight> lights;
+  std::vector<double> weights;
+  glm::vec3 lo(INFINITY), hi(-INFINITY);
+  for (std::size_t k = 0; k < triCount; ++k) {
+    std::uint32_t src = bvh.triangleOrder.empty() ? static_cast<std::uint32_t>(k) : bvh.triangleOrder[k];
+    glm::vec3 p0 = scene.positions[3 * src], p1 = scene.positions[3 * src + 1], p2 = scene.positions[3 * src + 2];
+    for (glm::vec3 p : {p0, p1, p2}) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+    tris[k].v0 = v4(p0);
+    tris[k].e1 = v4(p1 - p0);
+    tris[k].e2 = v4(p2 - p0);
+    shading[k].n0 = v4(scene.normals[3 * src]);
+    shading[k].n1 = v4(scene.normals[3 * src + 1]);
+    shading[k].n2 = v4(scene.normals[3 * src + 2]);
+    std::uint32_t mat = scene.triangleMaterial[src];
+    std::uint32_t lightIndex = INVALID_INDEX;
+    if (scene.materials[mat].emits()) {
+      float area = 0.5f * glm::length(glm::cross(p1 - p0, p2 - p0));
+      double power = double(luminance(scene.materials[mat].emission)) * area * M_PI;
+      if (power > 0) {
+        lightIndex = static_cast<std::uint32_t>(lights.size());
+        GpuLight l{};
+        l.info = glm::uvec4(LIGHT_TRIANGLE, static_cast<std::uint32_t>(k), 0u, 0u);
+        lights.push_back(l);
+        weights.push_back(power);
+      }
+    }
+    shading[k].info = glm::uvec4(mat, lightIndex, 0u, 0u);
+  }
+  glm::vec3 centre = triCount ? 0.5f * (lo + hi) : glm::vec3(0.0f);
+  float radius = triCount ? 0.5f * glm::length(hi - lo) : 1.0f;
+  m_sphere = glm::vec4(centre, radius);
+
+  // ---- Punctual lights (KHR_lights_punctual), by power ----
+  for (const PunctualLight& pl : scene.lights) {
+    GpuLight l{};
+    double power = 0;
+    float lum = luminance(pl.intensity);
+    switch (pl.type) {
+      case LightType::Point:
+        l.info.x = LIGHT_POINT;
+        power = 4.0 * M_PI * lum;
+        break;
+      case LightType::Spot:
+        l.info.x = LIGHT_SPOT;
+        power = 2.0 * M_PI * (1.0 - std::cos(0.5 * (pl.innerConeAngle + pl.outerConeAngle))) * lum;
+        break;
+      case LightType::Directional:
+        l.info.x = LIGHT_DIRECTIONAL;
+        power = M_PI * double(radius) * radius * lum;
+        break;
+    }
+    if (!(power > 0)) continue;
+    l.position = v4(pl.position);
+    l.direction = v4(glm::normalize(pl.direction));
+    l.intensity = v4(pl.intensity);
+    l.cone = glm::vec4(std::cos(pl.innerConeAngle), std::cos(pl.outerConeAngle), 0.0f, 0.0f);
+    lights.push_back(l);
+    weights.push_back(power);
+  }
+  m_lights = weights.size();
+
+  // ---- Light selection proportional to estimated power ----
+  std::vector<float> cdf(lights.size() + 1, 0.0f);
+  double total = 0;
+  for (double w : weights) total += w;
+  double acc = 0;
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    acc += weights[i];
+    cdf[i + 1] = static_cast<float>(acc / total);
+  }
+  if (!weights.empty()) cdf.back() = 1.0f;
+  if (lights.empty()) lights.resize(1);
+  m_lightTotal = float(total);
+
+  // ---- Device buffers ----
+  std::vector<BvhNode> nodes = bvh.nodes;
+  if (nodes.empty()) {  // no triangles: a root whose two children are empty boxes
+    BvhNode n{};
+    n.min0 = n.min1 = glm::vec4(INFINITY);
+    n.max0 = n.max1 = glm::vec4(-INFINITY);
+    n.link = glm::uvec4(INVALID_INDEX, INVALID_INDEX, 0u, 0u);
+    nodes.push_back(n);
+  }
+  auto make = [&](vk::Buffer& b, VkDeviceSize bytes, const char* what, const void* data) {
+    b = vk::createBuffer(m_ctx, bytes, 0, false, what);
+    vk::uploadBuffer(m_ctx, b, data, bytes);
+  };
+  make(m_bvh, nodes.size() * sizeof(BvhNode), "BVH", nodes.data());
+  make(m_tris, tris.size() * sizeof(GpuTriangle), "triangle", tris.data());
+  make(m_shading, shading.size() * sizeof(GpuTriShading), "triangle shading", shading.data());
+  make(m_lightBuffer, lights.size() * sizeof(GpuLight), "light", lights.data());
+  make(m_lightCdf, cdf.size() * sizeof(float), "light CDF", cdf.data());
+}
+
+DeviceScene::~DeviceScene() {
+  for (vk::Buffer* b : {&m_bvh, &m_tris, &m_shading, &m_lightBuffer, &m_lightCdf}) vk::destroyBuffer(m_ctx, *b);
+}
+
+std::uint64_t DeviceScene::deviceBytes() const {
+  return m_bvh.size + m_tris.size + m_shading.size + m_lightBuffer.size + m_lightCdf.size;
+}
+
+void DeviceScene::fillGlobals(shared::Globals& g) const {
+  g.bvh = m_bvh.address;
+  g.triangles = m_tris.address;
+  g.shading = m_shading.address;
+  g.lights = m_lightBuffer.address;
+  g.lightCdf = m_lightCdf.address;
+  g.sceneSphere = m_sphere;
+  g.lightTotal = glm::vec4(m_lightTotal, 0, 0, 0);
+  g.background = v4(m_background);
+  g.counts.y = static_cast<std::uint32_t>(m_lights);
+  g.counts.z = static_cast<std::uint32_t>(m_triangles);
+}
+
+}  // namespace nusselt

@@ -1,0 +1,271 @@
+// path_integrator.cpp: path state, queues, pipelines and the wavefront pass.
+#include "render/path_integrator.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <thread>
+
+#include "../../shaders/shared/layout.h"
+#include "util/error.h"
+
+namespace nusselt {
+
+using shared::DispatchArgs;
+using shared::Globals;
+using shared::StageConstants;
+
+std::uint32_t PathIntegrator::capacityFor(const RenderSettings& settings, std::uint64_t pixels) {
+  std::uint32_t maxChunk = std::min<std::uint32_t>(settings.maxPathsPerChunk, 65535u * WORKGROUP_SIZE);
+  return static_cast<std::uint32_t>(std::min<std::uint64_t>(pixels, maxChunk));
+}
+
+std::uint64_t PathIntegrator::bytesFor(std::uint32_t capacity, std::size_t slots) {
+  // Nine vec4 arrays of path and shadow-ray state, the queues (counters and item arrays).
+  return std::uint64_t(capacity) * 9 * 16 + (QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + slots) * std::uint64_t(capacity)) * 4;
+}
+
+PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
+                               const std::vector<std::vector<std::uint32_t>>& slotKeys, std::uint64_t pixels)
+    : m_ctx(ctx), m_globals(globals), m_settings(settings), m_slotKeys(slotKeys), m_pixels(pixels) {
+  m_capacity = capacityFor(settings, pixels);
+  const std::uint64_t cap = m_capacity;
+  auto make = [&](VkDeviceSize bytes, const std::string& what, VkBufferUsageFlags usage = 0,
+                  bool host = false) -> vk::Buffer* {
+    m_buffers.push_back(vk::createBuffer(m_ctx, bytes, usage, host, what));
+    return &m_buffers.back();
+  };
+  m_buffers.reserve(16);  // pointers into m_buffers stay valid
+  Globals& g = m_globals.host();
+  g.pathOrigin = make(cap * 16, "path origin")->address;
+  g.pathDirection = make(cap * 16, "path direction")->address;
+  g.pathThroughput = make(cap * 16, "path throughput")->address;
+  g.pathRadiance = make(cap * 16, "path radiance")->address;
+  g.pathInfo = make(cap * 16, "path info")->address;
+  g.pathHit = make(cap * 16, "path hit")->address;
+  g.shadowOrigin = make(cap * 16, "shadow ray origin")->address;
+  g.shadowDirection = make(cap * 16, "shadow ray direction")->address;
+  g.shadowRadiance = make(cap * 16, "shadow ray radiance")->address;
+  std::uint64_t queueUints = QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + m_slotKeys.size()) * cap;
+  m_queues = make(queueUints * 4, "queue");
+  g.queues = m_queues->address;
+  m_args = make(QUEUE_COUNT * sizeof(DispatchArgs), "dispatch arguments", VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+  g.dispatchArgs = m_args->address;
+  m_stats = make(STAT_COUNT * 4, "statistics", 0, true);
+  std::memset(m_stats->mapped, 0, STAT_COUNT * 4);
+  g.stats = m_stats->address;
+  g.frame.z = m_settings.maxDepth;
+  g.frame.w = m_capacity;
+
+  auto t0 = std::chrono::steady_clock::now();
+  createPipelines();
+  m_pipelineSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  ai.commandPool = m_ctx.commandPool;
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  VK_CHECK(vkAllocateCommandBuffers(m_ctx.device, &ai, &m_cmd));
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VK_CHECK(vkCreateFence(m_ctx.device, &fci, nullptr, &m_fence));
+  if (settings.timeStages && m_ctx.properties.limits.timestampComputeAndGraphics) {
+    m_queryCapacity = 8 + (settings.maxDepth + 1) * 8;
+    VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    q.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    q.queryCount = m_queryCapacity;
+    VK_CHECK(vkCreateQueryPool(m_ctx.device, &q, nullptr, &m_queryPool));
+  }
+}
+
+PathIntegrator::~PathIntegrator() {
+  VkDevice d = m_ctx.device;
+  vkDeviceWaitIdle(d);
+  if (m_fence) vkDestroyFence(d, m_fence, nullptr);
+  if (m_queryPool) vkDestroyQueryPool(d, m_queryPool, nullptr);
+  if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
+  for (auto* p : {&m_camera, &m_submit, &m_intersect, &m_shadow, &m_accumulate}) vk::destroyComputePipeline(m_ctx, *p);
+  for (auto& p : m_shade) vk::destroyComputePipeline(m_ctx, p);
+  for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
+}
+
+std::uint64_t PathIntegrator::deviceBytes() const {
+  std::uint64_t total = 0;
+  for (const vk::Buffer& b : m_buffers) total += b.size;
+  return total;
+}
+
+void PathIntegrator::mark(VkCommandBuffer cmd, const char* stage) {
+  if (!m_queryPool) return;
+  std::uint32_t index = static_cast<std::uint32_t>(m_marks.size()) + 1;
+  if (stage == nullptr) index = 0;  // the start
+  else m_marks.push_back(stage);
+  if (index < m_queryCapacity) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, m_queryPool, index);
+}
+
+void PathIntegrator::createPipelines() {
+  const VkPipelineLayout layout = m_globals.layout();
+  m_camera = vk::createComputePipeline(m_ctx, layout, "camera");
+  m_submit = vk::createComputePipeline(m_ctx, layout, "submit");
+  m_intersect = vk::createComputePipeline(m_ctx, layout, "intersect");
+  m_shadow = vk::createComputePipeline(m_ctx, layout, "shadow");
+  m_accumulate = vk::createComputePipeline(m_ctx, layout, "accumulate");
+  // Only the models (and combinations) this scene uses: one specialised shade pipeline each,
+  // created on all cores (drivers compile at creation; lavapipe takes ~0.3 s per shade pipeline,
+  // single-threaded). Single-model pipelines get exactly (MODEL_ID, SAMPLER); combined ones
+  // (MODEL_ID unused, SAMPLER, COMPONENT_COUNT, MODEL_0..MODEL_3).
+  const std::size_t slotCount = m_slotKeys.size();
+  m_shade.resize(slotCount);
+  std::vector<std::thread> workers;
+  std::vector<std::string> errors(slotCount);
+  const unsigned threads = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), unsigned(slotCount)));
+  for (unsigned t = 0; t < threads; ++t)
+    workers.emplace_back([&, t] {
+      for (std::size_t s = t; s < slotCount; s += threads) {
+        try {
+          const std::vector<std::uint32_t>& key = m_slotKeys[s];
+          const std::uint32_t sampler = static_cast<std::uint32_t>(m_settings.sampler);
+          std::vector<std::uint32_t> spec{key[1], sampler};
+          if (key[0] > 0) {
+            spec.push_back(key[0]);
+            for (std::uint32_t k = 0; k < MAX_COMPONENTS; ++k) spec.push_back(k < key[0] ? key[1 + k] : key[1]);
+          }
+          // One module per strategy (CMakeLists.txt): shade_sN / shade_combined_sN.
+          const std::string module = std::string(key[0] > 0 ? "shade_combined" : "shade") + "_s" + std::to_string(sampler);
+          m_shade[s] = vk::createComputePipeline(m_ctx, layout, module, spec);
+        } catch (const std::exception& e) {
+          errors[s] = e.what();
+        }
+      }
+    });
+  for (auto& w : workers) w.join();
+  for (const std::string& e : errors)
+    if (!e.empty()) throw Error(e);
+}
+
+void PathIntegrator::dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst,
+                                    std::uint32_t zeroCount, std::uint32_t argsFirst, std::uint32_t argsCount) {
+  StageConstants pc{};
+  pc.queueA = queueA;
+  pc.queueB = zeroFirst;
+  pc.queueBCount = zeroCount;
+  pc.queueC = argsFirst;
+  pc.queueCCount = argsCount;
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_submit.pipeline);
+  vkCmdPushConstants(cmd, m_globals.layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
+  vkCmdDispatch(cmd, 1, 1, 1);
+  vk::computeBarrier(cmd);
+}
+
+void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
+  const std::uint32_t slots = static_cast<std::uint32_t>(m_slotKeys.size());
+  const VkPipelineLayout layout = m_globals.layout();
+  const VkDescriptorSet set = m_globals.set();
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);
+  m_marks.clear();
+  if (m_queryPool) vkCmdResetQueryPool(cmd, m_queryPool, 0, m_queryCapacity);
+  mark(cmd, nullptr);
+  // All queues start empty.
+  vkCmdFillBuffer(cmd, m_queues->buffer, 0, QUEUE_HEADER_UINTS * 4, 0);
+  vk::computeBarrier(cmd);
+
+  StageConstants pc{};
+  auto bindAndPush = [&](const vk::ComputePipeline& p) {
+    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
+  };
+  const std::uint32_t groups = (chunkCount + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE;
+  bindAndPush(m_camera);
+  vkCmdDispatch(cmd, groups, 1, 1);
+  vk::computeBarrier(cmd);
+  mark(cmd, "camera");
+
+  for (std::uint32_t bounce = 0; bounce <= m_settings.maxDepth; ++bounce) {
+    const std::uint32_t rayQueue = bounce & 1u;
+    pc.bounce = bounce;
+    // intersect <- ray queue; empties the shadow queue of the previous bounce.
+    dispatchSubmit(cmd, rayQueue, QUEUE_SHADOW, 1, 0, 0);
+    mark(cmd, "submit");
+    bindAndPush(m_intersect);
+    vkCmdDispatchIndirect(cmd, m_args->buffer, rayQueue * sizeof(DispatchArgs));
+    vk::computeBarrier(cmd);
+    mark(cmd, "intersect");
+    // shade(model) <- shade queues; empties the consumed ray queue.
+    dispatchSubmit(cmd, INVALID_INDEX, rayQueue, 1, QUEUE_SHADE_BASE, slots);
+    mark(cmd, "submit");
+    for (std::uint32_t s = 0; s < slots; ++s) {
+      pc.modelSlot = s;
+      bindAndPush(m_shade[s]);
+      vkCmdDispatchIndirect(cmd, m_args->buffer, (QUEUE_SHADE_BASE + s) * sizeof(DispatchArgs));
+    }
+    vk::computeBarrier(cmd);
+    mark(cmd, "shade");
+    // shadow <- shadow queue; empties the shade queues.
+    dispatchSubmit(cmd, QUEUE_SHADOW, QUEUE_SHADE_BASE, slots, 0, 0);
+    mark(cmd, "submit");
+    bindAndPush(m_shadow);
+    vkCmdDispatchIndirect(cmd, m_args->buffer, QUEUE_SHADOW * sizeof(DispatchArgs));
+    vk::computeBarrier(cmd);
+    mark(cmd, "shadow");
+  }
+  bindAndPush(m_accumulate);
+  vkCmdDispatch(cmd, groups, 1, 1);
+  vk::computeBarrier(cmd);
+  mark(cmd, "accumulate");
+}
+
+void PathIntegrator::renderPass(std::uint32_t sampleIndex) {
+  for (std::uint64_t start = 0; start < m_pixels; start += m_capacity) {
+    std::uint32_t count = static_cast<std::uint32_t>(std::min<std::uint64_t>(m_capacity, m_pixels - start));
+    Globals& g = m_globals.host();
+    g.image.z = static_cast<std::uint32_t>(start);
+    g.image.w = count;
+    g.frame.x = sampleIndex;
+    m_globals.upload();
+
+    VK_CHECK(vkResetCommandBuffer(m_cmd, 0));
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    VK_CHECK(vkBeginCommandBuffer(m_cmd, &bi));
+    recordPass(m_cmd, count);
+    VK_CHECK(vkEndCommandBuffer(m_cmd));
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &m_cmd;
+    VK_CHECK(vkResetFences(m_ctx.device, 1, &m_fence));
+    VK_CHECK(vkQueueSubmit(m_ctx.queue, 1, &si, m_fence));
+    VK_CHECK(vkWaitForFences(m_ctx.device, 1, &m_fence, VK_TRUE, UINT64_MAX));
+    if (m_queryPool && !m_marks.empty()) {
+      std::uint32_t n = std::min<std::uint32_t>(static_cast<std::uint32_t>(m_marks.size()) + 1, m_queryCapacity);
+      std::vector<std::uint64_t> t(n);
+      VK_CHECK(vkGetQueryPoolResults(m_ctx.device, m_queryPool, 0, n, n * 8, t.data(), 8,
+                                     VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+      const double period = m_ctx.properties.limits.timestampPeriod * 1e-9;
+      for (std::uint32_t i = 1; i < n; ++i) {
+        const char* name = m_marks[i - 1];
+        auto it = std::find_if(m_stageSeconds.begin(), m_stageSeconds.end(), [&](auto& e) { return e.first == name; });
+        if (it == m_stageSeconds.end()) it = m_stageSeconds.insert(m_stageSeconds.end(), {name, 0.0});
+        it->second += double(t[i] - t[i - 1]) * period;
+      }
+    }
+    // Fold the 32-bit device counters into 64-bit totals and restart them.
+    std::uint32_t* s = static_cast<std::uint32_t*>(m_stats->mapped);
+    m_totals.rays += s[STAT_RAYS];
+    m_totals.shadowRays += s[STAT_SHADOW_RAYS];
+    m_totals.nonFiniteSamples += s[STAT_NONFINITE_SAMPLES];
+    m_totals.bvhStackOverflows += s[STAT_BVH_STACK_OVERFLOW];
+    m_totals.samplerBoundViolations += s[STAT_SAMPLER_BOUND_VIOLATIONS];
+    m_totals.samplerTrialFailures += s[STAT_SAMPLER_TRIAL_FAILURES];
+    std::memset(s, 0, STAT_COUNT * 4);
+  }
+}
+
+void PathIntegrator::addStats(const RenderStats& c) {
+  m_totals.rays += c.rays;
+  m_totals.shadowRays += c.shadowRays;
+  m_totals.nonFiniteSamples += c.nonFiniteSamples;
+  m_totals.bvhStackOverflows += c.bvhStackOverflows;
+  m_totals.samplerBoundViolations += c.samplerBoundViolations;
+  m_totals.samplerTrialFailures += c.samplerTrialFailures;
+}
+
+}  // namespace nusselt

@@ -1,0 +1,68 @@
+// path_integrator.h: the wavefront path tracer. Each pass traces one path per pixel through the
+// stages
+//   camera -> [intersect -> shade(slot) -> shadow] x (max depth + 1) -> accumulate
+// with queues between them: a queue is a count plus path ids, and the one-workgroup submit stage
+// turns counts into indirect dispatch sizes, so every stage processes only live paths.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "render/integrator.h"
+
+namespace nusselt {
+
+class PathIntegrator : public Integrator {
+ public:
+  // slotKeys: the material table's shade slots (one specialised shade pipeline each).
+  // pixels: the film's size; paths are traced in chunks of at most `capacity` pixels.
+  PathIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
+                 const std::vector<std::vector<std::uint32_t>>& slotKeys, std::uint64_t pixels);
+  ~PathIntegrator() override;
+
+  // Paths traced together in one chunk of a pass for this render (one indirect dispatch covers a
+  // whole queue: its group count must stay <= 65535).
+  static std::uint32_t capacityFor(const RenderSettings& settings, std::uint64_t pixels);
+  // Device bytes of the path state and queues.
+  static std::uint64_t bytesFor(std::uint32_t capacity, std::size_t slots);
+
+  void renderPass(std::uint32_t sampleIndex) override;
+  RenderStats stats() const override { return m_totals; }
+  void addStats(const RenderStats& carried) override;
+  const std::vector<std::pair<std::string, double>>& stageSeconds() const override { return m_stageSeconds; }
+  std::uint64_t deviceBytes() const override;
+  double pipelineSeconds() const { return m_pipelineSeconds; }
+
+ private:
+  void createPipelines();
+  void recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount);
+  void dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst, std::uint32_t zeroCount,
+                      std::uint32_t argsFirst, std::uint32_t argsCount);
+  void mark(VkCommandBuffer cmd, const char* stage);
+
+  vk::Context& m_ctx;
+  StageGlobals& m_globals;
+  RenderSettings m_settings;
+  std::vector<std::vector<std::uint32_t>> m_slotKeys;
+  std::uint64_t m_pixels = 0;
+  std::uint32_t m_capacity = 0;
+  RenderStats m_totals;
+  double m_pipelineSeconds = 0;
+
+  std::vector<vk::Buffer> m_buffers;  // path state, destroyed together
+  vk::Buffer* m_queues = nullptr;
+  vk::Buffer* m_args = nullptr;
+  vk::Buffer* m_stats = nullptr;
+
+  vk::ComputePipeline m_camera, m_submit, m_intersect, m_shadow, m_accumulate;
+  std::vector<vk::ComputePipeline> m_shade;  // one per slot
+  VkCommandBuffer m_cmd = VK_NULL_HANDLE;
+  VkFence m_fence = VK_NULL_HANDLE;
+  VkQueryPool m_queryPool = VK_NULL_HANDLE;
+  std::uint32_t m_queryCapacity = 0;
+  std::vector<const char*> m_marks;  // stage name of each timestamp after the first
+  std::vector<std::pair<std::string, double>> m_stageSeconds;
+};
+
+}  // namespace nusselt

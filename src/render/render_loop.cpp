@@ -1,0 +1,95 @@
+// render_loop.cpp: passes, stop conditions, checkpoints, progress and the record of a render.
+#include "render/render_loop.h"
+
+#include <csignal>
+#include <cstdio>
+
+#include "util/error.h"
+#include "util/progress.h"
+#include "util/stop_signal.h"
+
+namespace nusselt {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+RenderLoop::RenderLoop(Renderer& renderer, RenderRecord base, const RenderRecord& previous, RenderLoopOptions options)
+    : m_renderer(renderer), m_base(std::move(base)), m_previous(previous), m_options(std::move(options)) {
+  m_start = m_lastCheckpoint = std::chrono::steady_clock::now();
+  if (m_options.progress) {
+    const RenderSettings& s = m_renderer.settings();
+    m_progress = std::make_unique<Progress>("render", m_options.spp, std::uint64_t(s.width) * s.height, false,
+                                            m_options.quiet);
+    m_progress->update(m_renderer.samplesDone());
+  }
+}
+
+RenderLoop::~RenderLoop() = default;
+
+double RenderLoop::seconds() const { return secondsSince(m_start); }
+
+bool RenderLoop::interrupted() const { return g_stopSignal != 0; }
+
+bool RenderLoop::step() {
+  if (m_renderer.samplesDone() >= m_options.spp || g_stopSignal != 0) return false;
+  if (m_options.timeBudget > 0 && seconds() >= m_options.timeBudget) return false;
+  try {
+    m_renderer.renderPass();
+  } catch (const Error& e) {
+    // The device was lost or ran out of memory mid-render: its film cannot be read any more.
+    const std::string saved =
+        m_checkpointSpp > 0 ? "; the last checkpoint (" + std::to_string(m_checkpointSpp) + " spp) is in " +
+                                  m_options.output + ": continue with --resume " + m_options.output
+        : m_previous.spp > 0 ? "; the resumed file still holds its " + std::to_string(m_previous.spp) + " spp"
+                             : "; no checkpoint had been written yet (see --checkpoint)";
+    throw Error(std::string(e.what()) + " after " + std::to_string(m_renderer.samplesDone()) + " spp" + saved);
+  }
+  if (m_progress) m_progress->update(m_renderer.samplesDone());
+  // A periodic checkpoint: the output file always holds a resumable image, so a crash, a power
+  // cut or a lost device loses at most one interval of work.
+  if (m_options.checkpointSeconds > 0 && !m_options.output.empty() && m_renderer.samplesDone() < m_options.spp &&
+      secondsSince(m_lastCheckpoint) >= m_options.checkpointSeconds) {
+    write(m_options.output, true);
+    m_checkpointSpp = m_renderer.samplesDone();
+    m_lastCheckpoint = std::chrono::steady_clock::now();
+  }
+  return true;
+}
+
+void RenderLoop::run() {
+  while (step()) {
+  }
+  if (!m_progress) return;
+  const double sec = seconds();
+  const RenderStats st = m_renderer.stats();
+  char extra[64];
+  std::snprintf(extra, sizeof extra, "%.2f Mrays/s",
+                (st.rays + st.shadowRays - m_previous.stats.rays - m_previous.stats.shadowRays) / 1e6 /
+                    std::max(1e-9, sec));
+  m_progress->finish(extra);
+}
+
+RenderRecord RenderLoop::record(bool checkpoint) const {
+  RenderRecord r = m_base;
+  r.spp = m_renderer.samplesDone();
+  r.interrupted = g_stopSignal != 0;
+  r.checkpoint = checkpoint;
+  r.stats = m_renderer.stats();
+  r.renderSeconds = m_previous.renderSeconds + seconds();
+  r.totalSeconds = m_previous.totalSeconds + secondsSince(m_start) + m_base.totalSeconds;
+  r.timeBudget = m_options.timeBudget;
+  return r;
+}
+
+void RenderLoop::write(const std::string& path, bool checkpoint, const std::string& png, float exposure) {
+  Image img = m_renderer.image(m_options.variance);
+  writeExr(path, img, makeMetadata(record(checkpoint)));
+  if (!png.empty()) writePng(png, img, exposure);
+}
+
+}  // namespace nusselt

@@ -1,0 +1,159 @@
+// render_record.cpp: the EXR header of a render, written and read.
+#include "render/render_record.h"
+
+#include <cstdio>
+#include <sstream>
+
+#include "util/error.h"
+
+namespace nusselt {
+
+namespace {
+
+// "perspective px py pz fx fy fz ux uy uz yfov" or "orthographic ... xmag ymag": %.9g round-trips
+// every float exactly, so a resumed render traces the very same rays.
+std::string cameraText(const Camera& c) {
+  char buf[512];
+  if (c.orthographic)
+    std::snprintf(buf, sizeof buf, "orthographic %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g", c.position.x,
+                  c.position.y, c.position.z, c.forward.x, c.forward.y, c.forward.z, c.up.x, c.up.y, c.up.z, c.xmag, c.ymag);
+  else
+    std::snprintf(buf, sizeof buf, "perspective %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g", c.position.x,
+                  c.position.y, c.position.z, c.forward.x, c.forward.y, c.forward.z, c.up.x, c.up.y, c.up.z, c.yfov);
+  return buf;
+}
+
+bool parseCamera(const std::string& text, Camera& c) {
+  std::istringstream in(text);
+  std::string kind;
+  in >> kind;
+  c.orthographic = kind == "orthographic";
+  if (!c.orthographic && kind != "perspective") return false;
+  in >> c.position.x >> c.position.y >> c.position.z >> c.forward.x >> c.forward.y >> c.forward.z >> c.up.x >> c.up.y >>
+      c.up.z;
+  if (c.orthographic) in >> c.xmag >> c.ymag;
+  else in >> c.yfov;
+  return bool(in);
+}
+
+}  // namespace
+
+ImageMetadata makeMetadata(const RenderRecord& r) {
+  ImageMetadata meta;
+  meta.strings = {{"nusselt/version", NUSSELT_VERSION},
+                  {"nusselt/scene", r.scene},
+                  {"nusselt/device", r.device},
+                  {"nusselt/driver", r.driver},
+                  {"nusselt/source", r.source},
+                  {"nusselt/integrator", std::string("wavefront path tracer: NEE + BSDF sampling, MIS power "
+                                         "heuristic, ") + rouletteModeName(r.settings.roulette) + " Russian roulette"},
+                  {"nusselt/roulette", rouletteModeName(r.settings.roulette)},
+                  {"nusselt/lighting", lightingModeName(r.settings.lighting)},
+                  {"nusselt/rng", rngModeName(r.settings.rng)},
+                  {"nusselt/sampler", samplerName(r.settings.sampler)},
+                  {"nusselt/components", componentSelectionName(r.settings.components)},
+                  {"nusselt/models", r.models},
+                  {"nusselt/camera", cameraText(r.camera)}};
+  meta.ints = {{"nusselt/spp", r.spp},
+               {"nusselt/sppOffset", r.settings.sampleOffset},
+               {"nusselt/seed", r.settings.seed},
+               {"nusselt/maxDepth", r.settings.maxDepth},
+               {"nusselt/interrupted", r.interrupted ? 1 : 0},
+               {"nusselt/checkpoint", r.checkpoint ? 1 : 0},
+               {"nusselt/rays", static_cast<std::int64_t>(r.stats.rays)},
+               {"nusselt/shadowRays", static_cast<std::int64_t>(r.stats.shadowRays)},
+               {"nusselt/nonFiniteSamples", static_cast<std::int64_t>(r.stats.nonFiniteSamples)},
+               {"nusselt/bvhStackOverflows", static_cast<std::int64_t>(r.stats.bvhStackOverflows)},
+               {"nusselt/samplerBoundViolations", static_cast<std::int64_t>(r.stats.samplerBoundViolations)},
+               {"nusselt/samplerTrialFailures", static_cast<std::int64_t>(r.stats.samplerTrialFailures)},
+               {"nusselt/droppedTriangles", static_cast<std::int64_t>(r.droppedTriangles)}};
+  meta.doubles = {{"nusselt/renderSeconds", r.renderSeconds}, {"nusselt/totalSeconds", r.totalSeconds}};
+  if (r.timeBudget > 0) meta.doubles.push_back({"nusselt/timeBudget", r.timeBudget});
+  if (r.source == "preview") meta.doubles.push_back({"nusselt/exposure", r.displayExposure});
+  return meta;
+}
+
+RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
+  auto str = [&](const char* name) {
+    auto v = findString(meta, name);
+    if (!v) throw Error(path + ": header attribute " + name + " is missing (not written by nusselt?)");
+    return *v;
+  };
+  auto num = [&](const char* name) {
+    auto v = findInt(meta, name);
+    if (!v || *v < 0) throw Error(path + ": header attribute " + name + " is missing or negative");
+    return *v;
+  };
+  RenderRecord r;
+  r.scene = str("nusselt/scene");
+  r.device = str("nusselt/device");
+  r.driver = findString(meta, "nusselt/driver").value_or("");
+  r.models = str("nusselt/models");
+  r.source = findString(meta, "nusselt/source").value_or("render");
+  const std::string lighting = str("nusselt/lighting");
+  bool lightingKnown = false;
+  for (LightingMode m : {LightingMode::Mis, LightingMode::NeeOnly, LightingMode::BsdfOnly})
+    if (lighting == lightingModeName(m)) {
+      r.settings.lighting = m;
+      lightingKnown = true;
+    }
+  if (!lightingKnown) throw Error(path + ": header attribute nusselt/lighting names an unknown estimator");
+  r.settings.rng = findString(meta, "nusselt/rng").value_or("pcg") == "qmc" ? RngMode::Qmc : RngMode::Pcg;
+  if (!parseSampler(str("nusselt/sampler"), r.settings.sampler))
+    throw Error(path + ": header attribute nusselt/sampler names an unknown sampler");
+  // Absent in files written before combined materials existed: those rendered in albedo mode.
+  if (!parseComponentSelection(findString(meta, "nusselt/components").value_or("albedo"), r.settings.components))
+    throw Error(path + ": header attribute nusselt/components names an unknown component selection");
+  // Absent in files written before the throughput roulette existed: those used the albedo roulette.
+  if (!parseRouletteMode(findString(meta, "nusselt/roulette").value_or("albedo"), r.settings.roulette))
+    throw Error(path + ": header attribute nusselt/roulette names an unknown roulette");
+  // Absent in files written before renders recorded their view: those used the scene's camera,
+  // which the caller fills in (hasCamera false here means: not recorded).
+  r.cameraRecorded = false;
+  if (auto cam = findString(meta, "nusselt/camera")) {
+    if (!parseCamera(*cam, r.camera)) throw Error(path + ": header attribute nusselt/camera is malformed");
+    r.cameraRecorded = true;
+  }
+  r.spp = static_cast<std::uint32_t>(num("nusselt/spp"));
+  r.settings.sampleOffset = static_cast<std::uint32_t>(num("nusselt/sppOffset"));
+  r.settings.seed = static_cast<std::uint32_t>(num("nusselt/seed"));
+  r.settings.maxDepth = static_cast<std::uint32_t>(num("nusselt/maxDepth"));
+  r.interrupted = findInt(meta, "nusselt/interrupted").value_or(0) != 0;
+  r.checkpoint = findInt(meta, "nusselt/checkpoint").value_or(0) != 0;
+  r.stats.rays = num("nusselt/rays");
+  r.stats.shadowRays = num("nusselt/shadowRays");
+  r.stats.nonFiniteSamples = num("nusselt/nonFiniteSamples");
+  r.stats.bvhStackOverflows = num("nusselt/bvhStackOverflows");
+  r.stats.samplerBoundViolations = num("nusselt/samplerBoundViolations");
+  r.stats.samplerTrialFailures = num("nusselt/samplerTrialFailures");
+  r.droppedTriangles = num("nusselt/droppedTriangles");
+  r.renderSeconds = findDouble(meta, "nusselt/renderSeconds").value_or(0);
+  r.totalSeconds = findDouble(meta, "nusselt/totalSeconds").value_or(0);
+  r.timeBudget = findDouble(meta, "nusselt/timeBudget").value_or(0);
+  r.displayExposure = findDouble(meta, "nusselt/exposure").value_or(0);
+  return r;
+}
+
+std::string firstDifference(const RenderRecord& a, const RenderRecord& b) {
+  auto differ = [](const std::string& what, const std::string& x, const std::string& y) {
+    return x == y ? std::string() : what + ": " + x + " vs " + y;
+  };
+  const RenderSettings &s = a.settings, &t = b.settings;
+  for (const std::string& d :
+       {differ("the scene", a.scene, b.scene),
+        differ("the image size", std::to_string(s.width) + "x" + std::to_string(s.height),
+               std::to_string(t.width) + "x" + std::to_string(t.height)),
+        differ("the seed (--seed)", std::to_string(s.seed), std::to_string(t.seed)),
+        differ("the max depth (--max-depth)", std::to_string(s.maxDepth), std::to_string(t.maxDepth)),
+        differ("the lighting (--lighting)", lightingModeName(s.lighting), lightingModeName(t.lighting)),
+        differ("the random numbers (--rng)", rngModeName(s.rng), rngModeName(t.rng)),
+        differ("the sampler (--sampler)", samplerName(s.sampler), samplerName(t.sampler)),
+        differ("the component selection (--components)", componentSelectionName(s.components),
+               componentSelectionName(t.components)),
+        differ("the roulette (--roulette)", rouletteModeName(s.roulette), rouletteModeName(t.roulette)),
+        differ("the camera", cameraText(a.camera), cameraText(b.camera))})
+    if (!d.empty()) return d;
+  return {};
+}
+
+}  // namespace nusselt
