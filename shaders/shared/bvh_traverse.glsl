@@ -75,7 +75,7 @@ bool traceClosest(vec3 origin, vec3 dir, float tmin, float tmax, out float t, ou
   b1 = 0.0f;
   b2 = 0.0f;
   tri = INVALID_INDEX;
-  if (g.counts.z == 0u) return false;  // empty scene: there is no node 0
+  if (g.triangleCount == 0u) return false;  // empty scene: there is no node 0
   BvhNodes nodes = g.bvh;
   Triangles triangles = g.triangles;
   BvhRay ray = bvhMakeRay(origin, dir);
@@ -143,7 +143,7 @@ bool traceClosest(vec3 origin, vec3 dir, float tmin, float tmax, out float t, ou
 // Any hit with tmin < t < tmax (shadow rays): returns at the first one found. Children are
 // visited in stored order: with no closest hit to shrink the interval, sorting buys nothing.
 bool traceAny(vec3 origin, vec3 dir, float tmin, float tmax) {
-  if (g.counts.z == 0u) return false;
+  if (g.triangleCount == 0u) return false;
   BvhNodes nodes = g.bvh;
   Triangles triangles = g.triangles;
   BvhRay ray = bvhMakeRay(origin, dir);

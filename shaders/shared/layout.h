@@ -31,13 +31,23 @@ SHARED_BEGIN
 #define QUEUE_COUNT (QUEUE_SHADE_BASE + MAX_MODEL_SLOTS)
 
 // ---- Statistics counters (stats buffer, uint each) -----------------------------------------------
-#define STAT_NONFINITE_SAMPLES 0u   // samples dropped because L was NaN or Inf
-#define STAT_RAYS 1u                // extension rays traced
-#define STAT_SHADOW_RAYS 2u         // shadow rays traced
-#define STAT_BVH_STACK_OVERFLOW 3u  // traversals that ran out of stack (must stay 0)
-#define STAT_SAMPLER_BOUND_VIOLATIONS 4u
-#define STAT_SAMPLER_TRIAL_FAILURES 5u
-#define STAT_COUNT 16u
+// The one list of the counters the stages keep: X(ID, index, name, description). It declares the
+// STAT_<ID> indices (below, for GLSL and C++), RenderStats' fields, their fold into 64-bit totals,
+// their EXR header attributes "nusselt/<name>", resume and merge (src/render/settings.h).
+#define NUSSELT_STATS(X)                                                                            \
+  X(NONFINITE_SAMPLES, 0, nonFiniteSamples, "samples dropped because L was NaN or Inf")             \
+  X(RAYS, 1, rays, "extension rays traced")                                                         \
+  X(SHADOW_RAYS, 2, shadowRays, "shadow rays traced")                                               \
+  X(BVH_STACK_OVERFLOW, 3, bvhStackOverflows, "BVH traversals that ran out of stack (must stay 0)") \
+  X(SAMPLER_BOUND_VIOLATIONS, 4, samplerBoundViolations, "quadtree samples whose f exceeded the leaf's bound") \
+  X(SAMPLER_TRIAL_FAILURES, 5, samplerTrialFailures, "quadtree rejection loops that hit their trial cap")
+#ifdef __cplusplus
+#define NUSSELT_STAT_INDEX(ID, index, name, what) constexpr std::uint32_t STAT_##ID = index;
+#else
+#define NUSSELT_STAT_INDEX(ID, index, name, what) const uint STAT_##ID = uint(index);
+#endif
+NUSSELT_STATS(NUSSELT_STAT_INDEX)
+#define STAT_COUNT 16u  // room in the stats buffer
 
 // ---- Light types ----------------------------------------------------------------------------------
 #define LIGHT_TRIANGLE 0u
@@ -195,16 +205,29 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer TabTables {
 // Per-render constants and the addresses of every buffer (buffer device addresses: no storage
 // buffer binding limits the size of a scene; lavapipe caps one binding at 128 MiB).
 struct Globals {
-  uvec4 image;      // width, height, first pixel of this chunk, pixels in this chunk
-  uvec4 frame;      // sample index of this pass, seed, max depth, path capacity
-  uvec4 counts;     // materials, lights, triangles, lighting mode (LIGHTING_*)
-  uvec4 options;    // random numbers (RNG_PCG / RNG_QMC), component choice (COMPONENTS_*), roulette (ROULETTE_*), 0
+  // The image and this pass (four uints at a time: the vec4s below stay 16-byte aligned).
+  uint width;            // image size in pixels
+  uint height;
+  uint chunkFirstPixel;  // first pixel of the chunk of paths this dispatch batch traces
+  uint chunkPixels;      // paths in this chunk
+  uint sampleIndex;      // sample index of this pass
+  uint seed;
+  uint maxDepth;
+  uint pathCapacity;     // paths per chunk: the stride of the queues' item arrays
+  // The scene and the render's modes.
+  uint materialCount;
+  uint lightCount;
+  uint triangleCount;
+  uint lighting;         // LIGHTING_*
+  uint rngMode;          // RNG_PCG or RNG_QMC
+  uint componentChoice;  // COMPONENTS_*
+  uint roulette;         // ROULETTE_*
+  uint reserved0;
   vec4 camPosition; // xyz, w = 1 for orthographic
   vec4 camRight;    // unit right * (tan(yfov/2) * aspect), or * xmag for orthographic
   vec4 camUp;       // unit up * tan(yfov/2), or * ymag for orthographic
   vec4 camForward;  // unit view direction
   vec4 sceneSphere; // bounding sphere of the scene: centre, radius (directional lights)
-  vec4 lightTotal;  // x = sum of light selection weights
   vec4 background;  // radiance of rays that escape the scene (rgb)
 
   BUFREF(BvhNodes) bvh;
@@ -238,28 +261,64 @@ struct Globals {
   BUFREF(TabTables) tabTables;
   BUFREF(Floats) tabData;      // the CDFs of every table
 };
-STATIC_ASSERT_SIZE(Globals, 64 + 7 * 16 + 29 * 8);
+STATIC_ASSERT_SIZE(Globals, 64 + 6 * 16 + 29 * 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 
-// Push constants of every stage.
-struct StageConstants {
-  uint bounce;     // current bounce (0 = camera ray)
-  uint modelSlot;  // shade stage: which shade queue to consume
-  uint queueA;     // submit stage: queue whose dispatch args to write (or INVALID_INDEX)
-  uint queueB;     // submit stage: first queue to zero
-  uint queueBCount;// submit stage: number of consecutive queues to zero
-  uint queueC;     // submit stage: first of a range of queues whose args to write
-  uint queueCCount;
-  uint pad;
+// ---- Push constants: one struct per kind of stage ---------------------------------------------------
+// The stages of a bounce (intersect, shade, shadow).
+struct BounceConstants {
+  uint bounce;     // current bounce (0 = the camera ray's hit)
+  uint modelSlot;  // shade: which shade queue (slot of the material table) to consume
+  uint reserved0;
+  uint reserved1;
 };
-STATIC_ASSERT_SIZE(StageConstants, 32);
+STATIC_ASSERT_SIZE(BounceConstants, 16);
 
-// The wavefront stages see the globals at binding 0 and StageConstants as push constants.
-// A standalone kernel (tests, tools) defines NUSSELT_STANDALONE_KERNEL and declares its own.
+// submit: turns queue counts into indirect dispatch arguments and empties consumed queues.
+struct SubmitConstants {
+  uint argsQueue;   // queue whose dispatch arguments to write, or INVALID_INDEX
+  uint argsFirst;   // first of a range of queues whose arguments to write
+  uint argsCount;
+  uint zeroFirst;   // first of a range of queues to empty
+  uint zeroCount;
+  uint reserved0;
+  uint reserved1;
+  uint reserved2;
+};
+STATIC_ASSERT_SIZE(SubmitConstants, 32);
+
+// display (the preview): tone mapping of the film into the display buffer.
+struct DisplayConstants {
+  float exposureScale;  // 2^stops
+  uint flags;           // DISPLAY_BGRA, DISPLAY_REINHARD
+  uint reserved0;
+  uint reserved1;
+};
+STATIC_ASSERT_SIZE(DisplayConstants, 16);
+#define DISPLAY_BGRA 1u      // byte order B, G, R, A instead of R, G, B, A
+#define DISPLAY_REINHARD 2u  // c / (1 + c) per channel instead of clamping to [0, 1]
+
+// sample_tool (`nusselt sample`, the GPU sampler tests): draws `count` directions, sample indices
+// first .. first + count - 1, for the known direction v (local frame).
+struct SampleToolConstants {
+  uint count;
+  uint first;
+  uint seed;
+  uint reserved0;
+  vec4 v;
+};
+STATIC_ASSERT_SIZE(SampleToolConstants, 32);
+
+// The pipeline layout's push-constant range: the largest of the structs above.
+#define STAGE_PUSH_BYTES 32u
+
+// The wavefront stages see the globals at set 0, binding 0; each declares its push constants
+// with STAGE_PUSH(ItsConstants) (its fields are then pc.<name>). A standalone kernel (tests,
+// tools) defines NUSSELT_STANDALONE_KERNEL and declares its own.
 #if !defined(__cplusplus) && !defined(NUSSELT_STANDALONE_KERNEL)
 layout(set = 0, binding = 0, std430) readonly buffer GlobalsBlock { Globals g; };
-layout(push_constant, std430) uniform PushBlock { StageConstants pc; };
+#define STAGE_PUSH(T) layout(push_constant, std430) uniform PushBlock { T pc; }
 #endif
 
 SHARED_FN float brdfParam(BrdfParams p, uint i) { return p.v[i / 4u][i % 4u]; }

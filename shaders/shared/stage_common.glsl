@@ -16,7 +16,7 @@ layout(local_size_x = WORKGROUP_SIZE) in;
 
 uint queueCount(uint queue) { return g.queues.v[queue]; }
 
-uint queueItem(uint queue, uint i) { return g.queues.v[QUEUE_HEADER_UINTS + queue * g.frame.w + i]; }
+uint queueItem(uint queue, uint i) { return g.queues.v[QUEUE_HEADER_UINTS + queue * g.pathCapacity + i]; }
 
 // Push a path id. Lanes of a subgroup may push to different queues (intersect sends each hit
 // to its model's shade queue): the lanes pushing to the same queue as the first remaining lane
@@ -32,7 +32,7 @@ void queuePush(uint queue, uint path) {
       uint base = 0u;
       if (subgroupElect()) base = atomicAdd(g.queues.v[queue], n);
       base = subgroupBroadcastFirst(base);
-      g.queues.v[QUEUE_HEADER_UINTS + queue * g.frame.w + base + rank] = path;
+      g.queues.v[QUEUE_HEADER_UINTS + queue * g.pathCapacity + base + rank] = path;
       return;
     }
   }
@@ -75,7 +75,7 @@ float lightSelectPdf(uint i) { return g.lightCdf.v[i + 1u] - g.lightCdf.v[i]; }
 // Light index for u in [0, 1): binary search over the CDF (at most 32 iterations).
 uint selectLight(float u) {
   uint lo = 0u;
-  uint hi = g.counts.y;  // cdf has counts.y + 1 entries
+  uint hi = g.lightCount;  // the CDF has lightCount + 1 entries
   for (int it = 0; it < 32 && lo + 1u < hi; ++it) {
     uint mid = (lo + hi) / 2u;
     if (g.lightCdf.v[mid] <= u) lo = mid; else hi = mid;
@@ -105,7 +105,7 @@ bool sampleLight(vec3 x, float uSelect, vec2 uPoint, out LightSample ls) {
   ls.dist = 0.0f;
   ls.value = vec3(0.0f);
   ls.pdf = 0.0f;
-  if (g.counts.y == 0u) return false;
+  if (g.lightCount == 0u) return false;
   uint li = selectLight(uSelect);
   float pSelect = lightSelectPdf(li);
   if (pSelect <= 0.0f) return false;

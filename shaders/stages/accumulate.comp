@@ -6,8 +6,8 @@
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
-  if (i >= g.image.w) return;
-  uint pixel = g.image.z + i;
+  if (i >= g.chunkPixels) return;
+  uint pixel = g.chunkFirstPixel + i;
   vec3 L = g.pathRadiance.v[i].xyz;
   if (!(isFinite(L.x) && isFinite(L.y) && isFinite(L.z))) {
     atomicAdd(g.stats.v[STAT_NONFINITE_SAMPLES], 1u);

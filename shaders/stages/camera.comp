@@ -6,16 +6,16 @@
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
-  if (i >= g.image.w) return;
-  uint pixel = g.image.z + i;
-  uint width = g.image.x;
+  if (i >= g.chunkPixels) return;
+  uint pixel = g.chunkFirstPixel + i;
+  uint width = g.width;
   uint px = pixel % width;
   uint py = pixel / width;
 
   // Pixel jitter: dimensions 0 and 1 (box filter over the pixel).
-  vec2 u = sample2(g.options.x, pixel, g.frame.x, 0u, g.frame.y);
+  vec2 u = sample2(g.rngMode, pixel, g.sampleIndex, 0u, g.seed);
   float sx = ((float(px) + u.x) / float(width)) * 2.0f - 1.0f;
-  float sy = 1.0f - ((float(py) + u.y) / float(g.image.y)) * 2.0f;
+  float sy = 1.0f - ((float(py) + u.y) / float(g.height)) * 2.0f;
 
   vec3 origin;
   vec3 dir;
@@ -32,6 +32,6 @@ void main() {
   g.pathThroughput.v[i] = vec4(1.0f, 1.0f, 1.0f, 1.0f);  // w: etaScale
   g.pathRadiance.v[i] = vec4(0.0f);
   g.pathInfo.v[i] = uvec4(pixel, 0u, 0u, 0u);
-  g.queues.v[QUEUE_HEADER_UINTS + QUEUE_RAY0 * g.frame.w + i] = i;
-  if (i == 0u) g.queues.v[QUEUE_RAY0] = g.image.w;
+  g.queues.v[QUEUE_HEADER_UINTS + QUEUE_RAY0 * g.pathCapacity + i] = i;
+  if (i == 0u) g.queues.v[QUEUE_RAY0] = g.chunkPixels;
 }

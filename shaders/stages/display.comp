@@ -8,17 +8,14 @@
 // copies into the swapchain image. Runs with the renderer's pipeline layout and descriptor set
 // after a pass has finished; it only reads the film.
 //
-// Push constants (StageConstants, the fields the wavefront stages leave free):
-//   queueA = exposure scale 2^stops (float bits)
-//   queueB = flags: DISPLAY_BGRA (byte order B,G,R,A instead of R,G,B,A), DISPLAY_REINHARD
-//            (c / (1 + c) per channel instead of clamping to [0, 1])
+// Push constants: DisplayConstants (layout.h): the exposure scale 2^stops and the flags
+// DISPLAY_BGRA, DISPLAY_REINHARD.
 // The default (clamp + exact sRGB OETF, rounded to nearest) is what `nusselt render --png` and
 // writePng do, so a preview screenshot and a headless PNG of the same film agree to within one
 // code value (float pow here, double pow there).
 #include "shared/layout.h"
 
-#define DISPLAY_BGRA 1u
-#define DISPLAY_REINHARD 2u
+STAGE_PUSH(DisplayConstants);
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -31,14 +28,14 @@ uint toSrgb8(float linear) {
 
 void main() {
   uvec2 p = gl_GlobalInvocationID.xy;
-  uint width = g.image.x;
-  uint height = g.image.y;
+  uint width = g.width;
+  uint height = g.height;
   if (p.x >= width || p.y >= height) return;
   uint pixel = p.y * width + p.x;
   vec4 sum = g.film.v[pixel];
   vec3 c = sum.w > 0.0f ? sum.xyz / sum.w : vec3(0.0f);
-  c *= uintBitsToFloat(pc.queueA);
-  uint flags = pc.queueB;
+  c *= pc.exposureScale;
+  uint flags = pc.flags;
   if ((flags & DISPLAY_REINHARD) != 0u) c = c / (vec3(1.0f) + max(c, vec3(0.0f)));
   uint r = toSrgb8(c.x);
   uint gg = toSrgb8(c.y);

@@ -3,6 +3,7 @@
 // intersect: closest hit for every path in the current ray queue. Hits go to the shade queue of
 // their material's model; escaping rays pick up the background and end.
 #include "shared/stage_common.glsl"
+STAGE_PUSH(BounceConstants);
 
 void main() {
   uint queue = pc.bounce & 1u;

@@ -5,14 +5,14 @@
 // sample_tool: draws directions with a BSDF sampling strategy for `nusselt sample` and the GPU
 // tests. MODEL_ID and SAMPLER (SAMPLER_QUADTREE, _COSINE, _UNIFORM, _ANALYTIC or _TABULATED) are
 // specialization constants (one model and strategy per pipeline, as in shade).
-// Inputs in Globals: image.x = samples in this dispatch, image.y = index of the first one,
-// frame.y = seed, camForward.xyz = the known direction v (local frame), materials.v[0] = the
-// material (info.z = its QuadSet, or its TabSet for tabulated). Outputs per sample i: film.v[i] = (w, pdf or 0 on failure),
+// Inputs: SampleToolConstants (count, first, seed, v) as push constants; in Globals the sampler's
+// tables and materials.v[0] = the material (info.z = its QuadSet, or its TabSet for tabulated). Outputs per sample i: film.v[i] = (w, pdf or 0 on failure),
 // filmSq.v[i] = (f rgb, 1 if the sample succeeded). Counters: stats (bound violations, trial
 // failures). Sample i uses rng2(i, 0, RNG_DIM_BSDF, seed) and the rejection stream of
 // (i, 0, RNG_DIM_BSDF, seed): the CPU reproduces it bit for bit up to float differences.
 #include "shared/layout.h"
 #include "shared/bsdf_sampling.h"
+STAGE_PUSH(SampleToolConstants);
 
 layout(local_size_x = WORKGROUP_SIZE) in;
 layout(constant_id = 0) const uint MODEL_ID = 0u;
@@ -20,11 +20,11 @@ layout(constant_id = 1) const uint SAMPLER = SAMPLER_QUADTREE;
 
 void main() {
   uint local = gl_GlobalInvocationID.x;
-  if (local >= g.image.x) return;
-  uint i = g.image.y + local;
+  if (local >= pc.count) return;
+  uint i = pc.first + local;
   GpuMaterial M = g.materials.v[0];
-  vec3 v = g.camForward.xyz;
-  uint seed = g.frame.y;
+  vec3 v = pc.v.xyz;
+  uint seed = pc.seed;
   vec2 u = rng2(i, 0u, RNG_DIM_BSDF, seed);
   vec3 w = vec3(0.0f);
   float pdf = 0.0f;

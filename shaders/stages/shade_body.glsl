@@ -13,6 +13,7 @@
 // constant, so each kernel contains exactly its components' code (shaders/shared/combined.h).
 #include "shared/stage_common.glsl"
 #include "shared/combined.h"
+STAGE_PUSH(BounceConstants);
 
 layout(constant_id = 0) const uint MODEL_ID = 0u;
 layout(constant_id = 1) const uint SAMPLER = SAMPLER_QUADTREE;
@@ -42,11 +43,11 @@ void main() {
   uint path = queueItem(queue, idx);
   uint bounce = pc.bounce;
   uint pixel = g.pathInfo.v[path].x;
-  uint sampleIndex = g.frame.x;
-  uint seed = g.frame.y;
-  uint lighting = g.counts.w;
-  uint rngMode = g.options.x;
-  uint roulette = g.options.z;
+  uint sampleIndex = g.sampleIndex;
+  uint seed = g.seed;
+  uint lighting = g.lighting;
+  uint rngMode = g.rngMode;
+  uint roulette = g.roulette;
 
   // ---- Hit geometry ----
   vec4 hit = g.pathHit.v[path];
@@ -95,7 +96,7 @@ void main() {
     wo = toLocal(wWorld, tt, bb, ns);
   }
   vec3 xo = offsetRay(x, ng);
-  bool last = bounce >= g.frame.z;
+  bool last = bounce >= g.maxDepth;
 
 #if !SHADE_COMBINED
   {
@@ -167,7 +168,7 @@ void main() {
   GpuComponent C0, C1, C2, C3;
   vec4 a = vec4(0.0f);  // choice weights a_k = w_k A_k(wo), from wo only
   uint first = M.components.x;
-  uint mode = combinedChoiceMode(g.options.y, roulette);
+  uint mode = combinedChoiceMode(g.componentChoice, roulette);
   if (COMPONENT_COUNT > 0u) { C0 = g.components.v[first]; a.x = componentChoiceWeight(mode, SAMPLER, MODEL_0, C0, wo); }
   if (COMPONENT_COUNT > 1u) { C1 = g.components.v[first + 1u]; a.y = componentChoiceWeight(mode, SAMPLER, MODEL_1, C1, wo); }
   if (COMPONENT_COUNT > 2u) { C2 = g.components.v[first + 2u]; a.z = componentChoiceWeight(mode, SAMPLER, MODEL_2, C2, wo); }

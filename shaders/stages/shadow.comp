@@ -2,6 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 // shadow: any-hit test of each queued shadow ray; unoccluded ones add their contribution.
 #include "shared/stage_common.glsl"
+STAGE_PUSH(BounceConstants);
 
 void main() {
   uint idx = gl_GlobalInvocationID.x;

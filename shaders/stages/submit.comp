@@ -4,6 +4,7 @@
 // (count -> ceil(count / WORKGROUP_SIZE) groups), tallies traced rays, and empties the queues
 // the previous stage consumed (zeux/niagara's tasksubmit pattern).
 #include "shared/stage_common.glsl"
+STAGE_PUSH(SubmitConstants);
 
 void writeArgs(uint queue) {
   uint count = g.queues.v[queue];
@@ -14,8 +15,8 @@ void writeArgs(uint queue) {
 
 void main() {
   uint t = gl_LocalInvocationID.x;
-  if (t == 0u && pc.queueA != INVALID_INDEX) writeArgs(pc.queueA);
-  for (uint q = t; q < pc.queueCCount; q += WORKGROUP_SIZE) writeArgs(pc.queueC + q);
+  if (t == 0u && pc.argsQueue != INVALID_INDEX) writeArgs(pc.argsQueue);
+  for (uint q = t; q < pc.argsCount; q += WORKGROUP_SIZE) writeArgs(pc.argsFirst + q);
   // Zero after reading: the zeroed range never overlaps the ranges read above.
-  for (uint q = t; q < pc.queueBCount; q += WORKGROUP_SIZE) g.queues.v[pc.queueB + q] = 0u;
+  for (uint q = t; q < pc.zeroCount; q += WORKGROUP_SIZE) g.queues.v[pc.zeroFirst + q] = 0u;
 }

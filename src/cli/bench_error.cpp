@@ -78,17 +78,8 @@ struct ErrorArgs {
 
 const std::vector<std::uint32_t> kStrategies = {SAMPLER_QUADTREE, SAMPLER_TABULATED, SAMPLER_ANALYTIC, SAMPLER_COSINE,
                                                 SAMPLER_UNIFORM};
-const char* strategyName(std::uint32_t s) {
-  switch (s) {
-    case SAMPLER_QUADTREE: return "quadtree";
-    case SAMPLER_TABULATED: return "tabulated";
-    case SAMPLER_ANALYTIC: return "analytic";
-    case SAMPLER_COSINE: return "cosine";
-    case SAMPLER_UNIFORM: return "uniform";
-  }
-  return "?";
-}
 SamplerKind samplerKind(std::uint32_t s) { return static_cast<SamplerKind>(s); }
+const char* strategyName(std::uint32_t s) { return samplerName(samplerKind(s)); }
 // Plot colours (sRGB 0-255) per strategy, in kStrategies order.
 const int kColours[5][3] = {{214, 39, 40}, {31, 119, 180}, {44, 160, 44}, {255, 127, 14}, {148, 103, 189}};
 const char* kColourNames[5] = {"red", "blue", "green", "orange", "purple"};

@@ -55,10 +55,6 @@ struct RenderArgs {
   bool sppGiven = false;
 };
 
-LightingMode parseLighting(const std::string& name) {
-  return name == "nee" ? LightingMode::NeeOnly : name == "bsdf" ? LightingMode::BsdfOnly : LightingMode::Mis;
-}
-
 int renderCommand(const RenderArgs& a) {
   if (a.spp == 0) throw Error("--spp 0: at least one sample per pixel is needed");
   const std::string output = !a.output.empty() ? a.output : !a.resume.empty() ? a.resume : "render.exr";
@@ -76,8 +72,8 @@ int renderCommand(const RenderArgs& a) {
   s.seed = a.seed;
   s.maxDepth = a.maxDepth;
   s.sampleOffset = a.sppOffset;
-  s.lighting = parseLighting(a.lighting);
-  s.rng = a.rng == "qmc" ? RngMode::Qmc : RngMode::Pcg;
+  parseLighting(a.lighting, s.lighting);
+  parseRngMode(a.rng, s.rng);
   parseSampler(a.sampler, s.sampler);
   parseComponentSelection(a.components, s.components);
   parseRouletteMode(a.roulette, s.roulette);
@@ -252,12 +248,7 @@ int mergeCommand(const std::vector<std::string>& inputs, const std::string& outp
     merged.spp += r.spp;
     merged.settings.sampleOffset = std::min(merged.settings.sampleOffset, r.settings.sampleOffset);
     merged.interrupted = merged.interrupted || r.interrupted;
-    merged.stats.rays += r.stats.rays;
-    merged.stats.shadowRays += r.stats.shadowRays;
-    merged.stats.nonFiniteSamples += r.stats.nonFiniteSamples;
-    merged.stats.bvhStackOverflows += r.stats.bvhStackOverflows;
-    merged.stats.samplerBoundViolations += r.stats.samplerBoundViolations;
-    merged.stats.samplerTrialFailures += r.stats.samplerTrialFailures;
+    merged.stats.add(r.stats);
     merged.renderSeconds += r.renderSeconds;
     merged.totalSeconds += r.totalSeconds;
   }
@@ -474,7 +465,7 @@ int runCli(int argc, char** argv) {
   render->add_option("--device", ra.device, "Vulkan device index (see `nusselt devices`; default: a discrete GPU if any)");
   render->add_option("--lighting", ra.lighting, "Light transport estimator: mis (NEE + BSDF sampling, power heuristic), "
                                                 "nee (light sampling only), bsdf (BSDF sampling only)")
-      ->capture_default_str()->check(CLI::IsMember({"mis", "nee", "bsdf"}));
+      ->capture_default_str()->check(CLI::IsMember(enumNames(kLightingNames)));
   render->add_option("--resume", ra.resume, "Continue the render saved in this EXR up to --spp samples in all "
                                             "(same scene and settings; written back to it unless -o is given)");
   render->add_option("--spp-offset", ra.sppOffset, "First sample index of this render: split a frame across machines "
@@ -483,20 +474,20 @@ int runCli(int argc, char** argv) {
   render->add_option("--sampler", ra.sampler, "BSDF sampling of non-delta models: quadtree (the generic sampler: "
                                               "density proportional to BRDF x cos for any model), cosine, uniform, analytic (the model's "
                                               "own importance sampling, cosine where it has none), tabulated")
-      ->capture_default_str()->check(CLI::IsMember({"quadtree", "cosine", "uniform", "analytic", "tabulated"}));
+      ->capture_default_str()->check(CLI::IsMember(enumNames(kSamplerNames)));
   render->add_option("--components", ra.components, "Component choice of combined materials: albedo (probability = "
                                                     "the component's albedo for the current direction, the rest ends "
                                                     "the walk: the random-walk source's estimator) or uniform "
                                                     "(probability 1/n and a separate albedo roulette)")
-      ->capture_default_str()->check(CLI::IsMember({"albedo", "uniform"}));
+      ->capture_default_str()->check(CLI::IsMember(enumNames(kComponentNames)));
   render->add_option("--roulette", ra.roulette, "Russian roulette: throughput (continue with the path throughput's "
                                                 "largest channel from the third bounce on; never amplifies a colour "
                                                 "channel) or albedo (the random-walk source's: continue with the "
                                                 "sample's luminance albedo; its survivors' saturated channels grow, "
                                                 "docs/performance.md)")
-      ->capture_default_str()->check(CLI::IsMember({"throughput", "albedo"}));
+      ->capture_default_str()->check(CLI::IsMember(enumNames(kRouletteNames)));
   render->add_option("--rng", ra.rng, "Random numbers: pcg (independent hashes) or qmc (padded Owen-scrambled Sobol)")
-      ->capture_default_str()->check(CLI::IsMember({"pcg", "qmc"}));
+      ->capture_default_str()->check(CLI::IsMember(enumNames(kRngNames)));
   render->add_option("--checkpoint", ra.checkpointSeconds, "Write the image so far to the output every this many seconds "
                                                           "(resumable with --resume; 0: never)")
       ->capture_default_str()->check(CLI::Range(0.0, 1e9));

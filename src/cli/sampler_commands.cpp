@@ -16,6 +16,7 @@
 
 #include "brdf/registry.h"
 #include "cli/commands.h"
+#include "render/settings.h"
 #include "quadtree/sample_run.h"
 #include "quadtree/quadtree_build.h"
 #include "quadtree/sampler_tables.h"
@@ -47,11 +48,9 @@ struct SampleArgs {
 };
 
 std::uint32_t strategyId(const std::string& name) {
-  if (name == "cosine") return SAMPLER_COSINE;
-  if (name == "uniform") return SAMPLER_UNIFORM;
-  if (name == "analytic") return SAMPLER_ANALYTIC;
-  if (name == "tabulated") return SAMPLER_TABULATED;
-  return SAMPLER_QUADTREE;
+  SamplerKind kind = SamplerKind::Quadtree;
+  parseSampler(name, kind);
+  return static_cast<std::uint32_t>(kind);
 }
 
 BrdfParams paramsFor(const ModelSpec& m, const std::string& preset, const std::vector<std::string>& extra) {
@@ -326,7 +325,7 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
   sample->add_option("--phi-tables", sa->phiTables, "Quadtree tables along phi (anisotropic models)")->capture_default_str()->check(CLI::Range(2u, 1024u));
   sample->add_option("--sampler", sa->sampler, "Strategy: quadtree, cosine, uniform, analytic (the model's own importance "
                                                "sampling), tabulated")
-      ->capture_default_str()->check(CLI::IsMember({"quadtree", "cosine", "uniform", "analytic", "tabulated"}));
+      ->capture_default_str()->check(CLI::IsMember(enumNames(kSamplerNames)));
   sample->add_option("--tab-bytes", sa->tabBytes, "tabulated: memory budget of one table in bytes (sets the grid)")
       ->capture_default_str()->check(CLI::Range(std::uint64_t(1024), std::uint64_t(1) << 30));
   sample->callback([sa, &run]() { run = [sa]() { return sampleCommand(*sa); }; });

@@ -136,8 +136,6 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
   std::memset(stats.mapped, 0, STAT_COUNT * 4);
   vk::Buffer globals = vk::createBuffer(ctx, sizeof(Globals), 0, true, "sampler globals");
   Globals g{};
-  g.frame = uvec4(0u, seed, 0u, 0u);
-  g.camForward = vec4(v, 0.0f);
   g.materials = materials.address;
   g.film = film.address;
   g.filmSq = filmSq.address;
@@ -151,17 +149,22 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
   g.tabData = tData.address;
 
   // Binding 0 = the Globals block, as the renderer's stages.
-  vk::GlobalsBinding binding = vk::createGlobalsBinding(ctx, globals.buffer, sizeof(StageConstants));
+  std::memcpy(globals.mapped, &g, sizeof g);
+  vk::GlobalsBinding binding = vk::createGlobalsBinding(ctx, globals.buffer, STAGE_PUSH_BYTES);
   VkPipelineLayout layout = binding.layout;
   VkDescriptorSet dset = binding.set;
   vk::ComputePipeline pipe = vk::createComputePipeline(ctx, layout, "sample_tool", {model, strategy});
 
+  SampleToolConstants pc{};
+  pc.seed = seed;
+  pc.v = vec4(v, 0.0f);
   if (warmUp) {  // lavapipe compiles the shader at its first dispatch: keep that out of the timing
-    g.image = uvec4(std::min<std::uint32_t>(n, WORKGROUP_SIZE), 0u, 0u, 0u);
-    std::memcpy(globals.mapped, &g, sizeof g);
+    pc.count = std::min<std::uint32_t>(n, WORKGROUP_SIZE);
+    pc.first = 0;
     VkCommandBuffer cmd = vk::beginOneShot(ctx);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &dset, 0, nullptr);
+    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
     vkCmdDispatch(cmd, 1, 1, 1);
     vk::endOneShot(ctx, cmd);
     std::memset(stats.mapped, 0, STAT_COUNT * 4);
@@ -171,11 +174,12 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
   const std::uint32_t chunk = 65535u * WORKGROUP_SIZE;
   for (std::uint32_t first = 0; first < n; first += chunk) {
     std::uint32_t count = std::min(chunk, n - first);
-    g.image = uvec4(count, first, 0u, 0u);
-    std::memcpy(globals.mapped, &g, sizeof g);
+    pc.count = count;
+    pc.first = first;
     VkCommandBuffer cmd = vk::beginOneShot(ctx);
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &dset, 0, nullptr);
+    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
     vkCmdDispatch(cmd, (count + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE, 1, 1);
     vk::endOneShot(ctx, cmd);
   }

@@ -119,7 +119,6 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene) : m_ctx(ctx), m_b
   }
   if (!weights.empty()) cdf.back() = 1.0f;
   if (lights.empty()) lights.resize(1);
-  m_lightTotal = float(total);
 
   // ---- Device buffers ----
   std::vector<BvhNode> nodes = bvh.nodes;
@@ -156,10 +155,9 @@ void DeviceScene::fillGlobals(shared::Globals& g) const {
   g.lights = m_lightBuffer.address;
   g.lightCdf = m_lightCdf.address;
   g.sceneSphere = m_sphere;
-  g.lightTotal = glm::vec4(m_lightTotal, 0, 0, 0);
   g.background = v4(m_background);
-  g.counts.y = static_cast<std::uint32_t>(m_lights);
-  g.counts.z = static_cast<std::uint32_t>(m_triangles);
+  g.lightCount = static_cast<std::uint32_t>(m_lights);
+  g.triangleCount = static_cast<std::uint32_t>(m_triangles);
 }
 
 }  // namespace nusselt

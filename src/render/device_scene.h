@@ -45,7 +45,6 @@ class DeviceScene {
   std::uint32_t m_bvhNodes = 0;
   double m_bvhSeconds = 0;
   glm::vec4 m_sphere{0.0f, 0.0f, 0.0f, 1.0f};
-  float m_lightTotal = 0;
   glm::vec3 m_background{0.0f};
   vk::Buffer m_bvh, m_tris, m_shading, m_lightBuffer, m_lightCdf;
 };

@@ -26,8 +26,8 @@ Film::~Film() {
 void Film::fillGlobals(shared::Globals& g) const {
   g.film = m_sum.address;
   g.filmSq = m_sumSq.address;
-  g.image.x = m_width;
-  g.image.y = m_height;
+  g.width = m_width;
+  g.height = m_height;
 }
 
 void Film::clear() {

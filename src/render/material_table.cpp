@@ -215,7 +215,7 @@ void MaterialTable::fillGlobals(shared::Globals& g) const {
   g.tabSets = m_tabSets.address;
   g.tabTables = m_tabTables.address;
   g.tabData = m_tabData.address;
-  g.counts.x = static_cast<std::uint32_t>(std::max<std::size_t>(m_materialCount, 1));
+  g.materialCount = static_cast<std::uint32_t>(std::max<std::size_t>(m_materialCount, 1));
 }
 
 }  // namespace nusselt

@@ -13,7 +13,8 @@ namespace nusselt {
 
 using shared::DispatchArgs;
 using shared::Globals;
-using shared::StageConstants;
+using shared::BounceConstants;
+using shared::SubmitConstants;
 
 std::uint32_t PathIntegrator::capacityFor(const RenderSettings& settings, std::uint64_t pixels) {
   std::uint32_t maxChunk = std::min<std::uint32_t>(settings.maxPathsPerChunk, 65535u * WORKGROUP_SIZE);
@@ -54,8 +55,8 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   m_stats = make(STAT_COUNT * 4, "statistics", 0, true);
   std::memset(m_stats->mapped, 0, STAT_COUNT * 4);
   g.stats = m_stats->address;
-  g.frame.z = m_settings.maxDepth;
-  g.frame.w = m_capacity;
+  g.maxDepth = m_settings.maxDepth;
+  g.pathCapacity = m_capacity;
 
   auto t0 = std::chrono::steady_clock::now();
   createPipelines();
@@ -144,12 +145,12 @@ void PathIntegrator::createPipelines() {
 
 void PathIntegrator::dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst,
                                     std::uint32_t zeroCount, std::uint32_t argsFirst, std::uint32_t argsCount) {
-  StageConstants pc{};
-  pc.queueA = queueA;
-  pc.queueB = zeroFirst;
-  pc.queueBCount = zeroCount;
-  pc.queueC = argsFirst;
-  pc.queueCCount = argsCount;
+  SubmitConstants pc{};
+  pc.argsQueue = queueA;
+  pc.argsFirst = argsFirst;
+  pc.argsCount = argsCount;
+  pc.zeroFirst = zeroFirst;
+  pc.zeroCount = zeroCount;
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_submit.pipeline);
   vkCmdPushConstants(cmd, m_globals.layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
   vkCmdDispatch(cmd, 1, 1, 1);
@@ -168,7 +169,7 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
   vkCmdFillBuffer(cmd, m_queues->buffer, 0, QUEUE_HEADER_UINTS * 4, 0);
   vk::computeBarrier(cmd);
 
-  StageConstants pc{};
+  BounceConstants pc{};
   auto bindAndPush = [&](const vk::ComputePipeline& p) {
     vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
     vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
@@ -217,9 +218,9 @@ void PathIntegrator::renderPass(std::uint32_t sampleIndex) {
   for (std::uint64_t start = 0; start < m_pixels; start += m_capacity) {
     std::uint32_t count = static_cast<std::uint32_t>(std::min<std::uint64_t>(m_capacity, m_pixels - start));
     Globals& g = m_globals.host();
-    g.image.z = static_cast<std::uint32_t>(start);
-    g.image.w = count;
-    g.frame.x = sampleIndex;
+    g.chunkFirstPixel = static_cast<std::uint32_t>(start);
+    g.chunkPixels = count;
+    g.sampleIndex = sampleIndex;
     m_globals.upload();
 
     VK_CHECK(vkResetCommandBuffer(m_cmd, 0));
@@ -249,23 +250,11 @@ void PathIntegrator::renderPass(std::uint32_t sampleIndex) {
     }
     // Fold the 32-bit device counters into 64-bit totals and restart them.
     std::uint32_t* s = static_cast<std::uint32_t*>(m_stats->mapped);
-    m_totals.rays += s[STAT_RAYS];
-    m_totals.shadowRays += s[STAT_SHADOW_RAYS];
-    m_totals.nonFiniteSamples += s[STAT_NONFINITE_SAMPLES];
-    m_totals.bvhStackOverflows += s[STAT_BVH_STACK_OVERFLOW];
-    m_totals.samplerBoundViolations += s[STAT_SAMPLER_BOUND_VIOLATIONS];
-    m_totals.samplerTrialFailures += s[STAT_SAMPLER_TRIAL_FAILURES];
+    m_totals.addDevice(s);
     std::memset(s, 0, STAT_COUNT * 4);
   }
 }
 
-void PathIntegrator::addStats(const RenderStats& c) {
-  m_totals.rays += c.rays;
-  m_totals.shadowRays += c.shadowRays;
-  m_totals.nonFiniteSamples += c.nonFiniteSamples;
-  m_totals.bvhStackOverflows += c.bvhStackOverflows;
-  m_totals.samplerBoundViolations += c.samplerBoundViolations;
-  m_totals.samplerTrialFailures += c.samplerTrialFailures;
-}
+void PathIntegrator::addStats(const RenderStats& c) { m_totals.add(c); }
 
 }  // namespace nusselt

@@ -46,9 +46,6 @@ namespace nusselt {
 
 namespace {
 
-// Flags of the display stage (push constant queueB); same values as shaders/stages/display.comp.
-constexpr std::uint32_t kDisplayBgra = 1u;
-constexpr std::uint32_t kDisplayReinhard = 2u;
 
 const char* const kKeysHelp =
     "Keys and mouse (any camera change restarts accumulation):\n"
@@ -71,18 +68,14 @@ const char* const kKeysHelp =
 // The sampling strategies the keys 1-5 name; a key switches RenderSettings::sampler (the shade
 // stages are specialised per strategy, so the renderer is recreated).
 struct SamplerKey {
-  const char* name;
+  SamplerKind kind;
   int key;
 };
-const SamplerKey kSamplers[] = {{"quadtree", GLFW_KEY_1},
-                                {"cosine", GLFW_KEY_2},
-                                {"analytic", GLFW_KEY_3},
-                                {"tabulated", GLFW_KEY_4},
-                                {"uniform", GLFW_KEY_5}};
-bool samplerAvailable(const std::string& name) {
-  SamplerKind kind;
-  return parseSampler(name, kind);
-}
+const SamplerKey kSamplers[] = {{SamplerKind::Quadtree, GLFW_KEY_1},
+                                {SamplerKind::Cosine, GLFW_KEY_2},
+                                {SamplerKind::Analytic, GLFW_KEY_3},
+                                {SamplerKind::Tabulated, GLFW_KEY_4},
+                                {SamplerKind::Uniform, GLFW_KEY_5}};
 
 
 struct PreviewArgs {
@@ -131,9 +124,6 @@ bool parseKeyName(std::string name, int& key, int& mods) {
   return false;
 }
 
-LightingMode parseLighting(const std::string& s) {
-  return s == "nee" ? LightingMode::NeeOnly : s == "bsdf" ? LightingMode::BsdfOnly : LightingMode::Mis;
-}
 
 // ---- 8-bit sRGB back to linear, exactly invertible by toSrgb8 (checked) ---------------------------
 const std::vector<float>& srgbDecodeTable() {
@@ -288,7 +278,6 @@ class Preview {
   bool m_paused = false;
   bool m_reinhard = false;
   float m_exposure = 0.0f;
-  std::string m_sampler = "quadtree";
   double m_lastX = 0, m_lastY = 0;
   bool m_haveCursor = false;
 
@@ -354,22 +343,13 @@ void Preview::onKey(int key, int mods) {
       return;
     }
     case GLFW_KEY_TAB: {
-      // Next available strategy after the current one (today: cosine again).
+      // The next strategy after the current one, in the keys' order.
       std::size_t n = sizeof kSamplers / sizeof kSamplers[0], cur = 0;
       for (std::size_t i = 0; i < n; ++i)
-        if (m_sampler == kSamplers[i].name) cur = i;
-      for (std::size_t k = 1; k <= n; ++k) {
-        const char* name = kSamplers[(cur + k) % n].name;
-        if (samplerAvailable(name)) {
-          if (m_sampler != name) {
-            m_sampler = name;
-            parseSampler(m_sampler, m_settings.sampler);
-            m_samplerDirty = true;  // recreate the renderer with the new strategy
-          }
-          break;
-        }
-      }
-      std::fprintf(stderr, "sampler: %s\n", m_sampler.c_str());
+        if (m_settings.sampler == kSamplers[i].kind) cur = i;
+      m_settings.sampler = kSamplers[(cur + 1) % n].kind;
+      m_samplerDirty = true;  // recreate the renderer with the new strategy
+      std::fprintf(stderr, "sampler: %s\n", samplerName(m_settings.sampler));
       updateTitle(true);
       return;
     }
@@ -380,14 +360,10 @@ void Preview::onKey(int key, int mods) {
   }
   for (const SamplerKey& s : kSamplers) {
     if (key != s.key) continue;
-    if (!samplerAvailable(s.name)) {
-      std::fprintf(stderr, "sampler %s is not available yet (quadtree, cosine, uniform and analytic are); staying with %s\n",
-                   s.name, m_sampler.c_str());
-    } else if (m_sampler != s.name) {
-      m_sampler = s.name;
-      parseSampler(m_sampler, m_settings.sampler);
+    if (m_settings.sampler != s.kind) {
+      m_settings.sampler = s.kind;
       m_samplerDirty = true;  // recreate the renderer with the new strategy
-      std::fprintf(stderr, "sampler: %s\n", s.name);
+      std::fprintf(stderr, "sampler: %s\n", samplerName(s.kind));
     }
     updateTitle(true);
   }
@@ -539,10 +515,10 @@ bool Preview::presentFrame() {
   VkDescriptorSet set = m_renderer->descriptorSet();
   vkCmdBindDescriptorSets(m_cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_renderer->pipelineLayout(), 0, 1, &set, 0, nullptr);
   vkCmdBindPipeline(m_cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_display.pipeline);
-  shared::StageConstants pc{};
-  pc.queueA = shared::floatBitsToUint(std::exp2(m_exposure));
-  pc.queueB = (m_format == VK_FORMAT_B8G8R8A8_UNORM || m_format == VK_FORMAT_B8G8R8A8_SRGB ? kDisplayBgra : 0u) |
-              (m_reinhard ? kDisplayReinhard : 0u);
+  shared::DisplayConstants pc{};
+  pc.exposureScale = std::exp2(m_exposure);
+  pc.flags = (m_format == VK_FORMAT_B8G8R8A8_UNORM || m_format == VK_FORMAT_B8G8R8A8_SRGB ? DISPLAY_BGRA : 0u) |
+             (m_reinhard ? DISPLAY_REINHARD : 0u);
   vkCmdPushConstants(m_cmd, m_renderer->pipelineLayout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
   vkCmdDispatch(m_cmd, (w + 7) / 8, (h + 7) / 8, 1);
   vk::computeBarrier(m_cmd);  // display writes -> transfer read
@@ -614,7 +590,7 @@ void Preview::updateTitle(bool force) {
   char title[512];
   std::snprintf(title, sizeof title,
                 "nusselt preview | %u spp | %.3g Msamples/s | sampler %s | lighting %s | exposure %+.1f (%s)%s | %ux%u | %s",
-                m_renderer ? m_renderer->samplesDone() : 0u, m_samplesPerSecond / 1e6, m_sampler.c_str(),
+                m_renderer ? m_renderer->samplesDone() : 0u, m_samplesPerSecond / 1e6, samplerName(m_settings.sampler),
                 lightingModeName(m_settings.lighting), m_exposure, m_reinhard ? "Reinhard" : "clamp",
                 m_paused ? " | paused" : (m_args.maxSpp && m_renderer && m_renderer->samplesDone() >= m_args.maxSpp ? " | done" : ""),
                 m_settings.width, m_settings.height, m_ctx.deviceName.c_str());
@@ -700,9 +676,8 @@ int Preview::run() {
   printSceneWarnings(m_scene, a.quiet);
   m_settings.seed = a.seed;
   m_settings.maxDepth = a.maxDepth;
-  m_settings.lighting = parseLighting(a.lighting);
-  m_sampler = a.sampler;
-  parseSampler(m_sampler, m_settings.sampler);
+  parseLighting(a.lighting, m_settings.lighting);
+  parseSampler(a.sampler, m_settings.sampler);
   m_settings.spp = 1;
   m_exposure = a.exposure;
   m_reinhard = a.tonemap == "reinhard";
@@ -757,7 +732,7 @@ int Preview::run() {
                  sum.triangles, sum.materials, models.c_str(), sum.lights);
     std::fprintf(stderr, "device: %s; window %ux%u, max depth %u, seed %u, lighting %s, sampler %s; press H for the keys\n",
                  m_ctx.deviceName.c_str(), m_settings.width, m_settings.height, m_settings.maxDepth, m_settings.seed,
-                 lightingModeName(m_settings.lighting), m_sampler.c_str());
+                 lightingModeName(m_settings.lighting), samplerName(m_settings.sampler));
   }
 
   std::unique_ptr<ScopedStopSignals> signals = std::make_unique<ScopedStopSignals>();
@@ -911,9 +886,9 @@ void registerPreviewCommand(CLI::App& app, CommandRunner& run) {
       ->capture_default_str();
   p->add_option("--max-depth", a->maxDepth, "Maximum path depth")->capture_default_str()->check(CLI::Range(0u, 1024u));
   p->add_option("--sampler", a->sampler, "BSDF sampling at start (keys 1-5 and Tab switch): quadtree, cosine, uniform")
-      ->capture_default_str()->check(CLI::IsMember({"quadtree", "cosine", "uniform", "analytic"}));
+      ->capture_default_str()->check(CLI::IsMember(enumNames(kSamplerNames)));
   p->add_option("--lighting", a->lighting, "Light transport estimator at start (L switches): mis, nee, bsdf")
-      ->capture_default_str()->check(CLI::IsMember({"mis", "nee", "bsdf"}));
+      ->capture_default_str()->check(CLI::IsMember(enumNames(kLightingNames)));
   p->add_option("--exposure", a->exposure, "Display exposure in stops ([ and ] change it)")->capture_default_str();
   p->add_option("--tonemap", a->tonemap, "Display tone map at start (T switches): clamp (as `render --png`), reinhard")
       ->capture_default_str()->check(CLI::IsMember({"clamp", "reinhard"}));

@@ -60,13 +60,10 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
                {"nusselt/maxDepth", r.settings.maxDepth},
                {"nusselt/interrupted", r.interrupted ? 1 : 0},
                {"nusselt/checkpoint", r.checkpoint ? 1 : 0},
-               {"nusselt/rays", static_cast<std::int64_t>(r.stats.rays)},
-               {"nusselt/shadowRays", static_cast<std::int64_t>(r.stats.shadowRays)},
-               {"nusselt/nonFiniteSamples", static_cast<std::int64_t>(r.stats.nonFiniteSamples)},
-               {"nusselt/bvhStackOverflows", static_cast<std::int64_t>(r.stats.bvhStackOverflows)},
-               {"nusselt/samplerBoundViolations", static_cast<std::int64_t>(r.stats.samplerBoundViolations)},
-               {"nusselt/samplerTrialFailures", static_cast<std::int64_t>(r.stats.samplerTrialFailures)},
                {"nusselt/droppedTriangles", static_cast<std::int64_t>(r.droppedTriangles)}};
+  r.stats.forEach([&](const char* name, const char*, std::uint64_t value) {
+    meta.ints.push_back({std::string("nusselt/") + name, static_cast<std::int64_t>(value)});
+  });
   meta.doubles = {{"nusselt/renderSeconds", r.renderSeconds}, {"nusselt/totalSeconds", r.totalSeconds}};
   if (r.timeBudget > 0) meta.doubles.push_back({"nusselt/timeBudget", r.timeBudget});
   if (r.source == "preview") meta.doubles.push_back({"nusselt/exposure", r.displayExposure});
@@ -90,15 +87,10 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   r.driver = findString(meta, "nusselt/driver").value_or("");
   r.models = str("nusselt/models");
   r.source = findString(meta, "nusselt/source").value_or("render");
-  const std::string lighting = str("nusselt/lighting");
-  bool lightingKnown = false;
-  for (LightingMode m : {LightingMode::Mis, LightingMode::NeeOnly, LightingMode::BsdfOnly})
-    if (lighting == lightingModeName(m)) {
-      r.settings.lighting = m;
-      lightingKnown = true;
-    }
-  if (!lightingKnown) throw Error(path + ": header attribute nusselt/lighting names an unknown estimator");
-  r.settings.rng = findString(meta, "nusselt/rng").value_or("pcg") == "qmc" ? RngMode::Qmc : RngMode::Pcg;
+  if (!parseLighting(str("nusselt/lighting"), r.settings.lighting))
+    throw Error(path + ": header attribute nusselt/lighting names an unknown estimator");
+  if (!parseRngMode(findString(meta, "nusselt/rng").value_or("pcg"), r.settings.rng))
+    throw Error(path + ": header attribute nusselt/rng names unknown random numbers");
   if (!parseSampler(str("nusselt/sampler"), r.settings.sampler))
     throw Error(path + ": header attribute nusselt/sampler names an unknown sampler");
   // Absent in files written before combined materials existed: those rendered in albedo mode.
@@ -120,12 +112,9 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   r.settings.maxDepth = static_cast<std::uint32_t>(num("nusselt/maxDepth"));
   r.interrupted = findInt(meta, "nusselt/interrupted").value_or(0) != 0;
   r.checkpoint = findInt(meta, "nusselt/checkpoint").value_or(0) != 0;
-  r.stats.rays = num("nusselt/rays");
-  r.stats.shadowRays = num("nusselt/shadowRays");
-  r.stats.nonFiniteSamples = num("nusselt/nonFiniteSamples");
-  r.stats.bvhStackOverflows = num("nusselt/bvhStackOverflows");
-  r.stats.samplerBoundViolations = num("nusselt/samplerBoundViolations");
-  r.stats.samplerTrialFailures = num("nusselt/samplerTrialFailures");
+  r.stats.forEach([&](const char* name, const char*, std::uint64_t& value) {
+    value = static_cast<std::uint64_t>(num((std::string("nusselt/") + name).c_str()));
+  });
   r.droppedTriangles = num("nusselt/droppedTriangles");
   r.renderSeconds = findDouble(meta, "nusselt/renderSeconds").value_or(0);
   r.totalSeconds = findDouble(meta, "nusselt/totalSeconds").value_or(0);

@@ -14,7 +14,6 @@
 namespace nusselt {
 
 using shared::Globals;
-using shared::StageConstants;
 
 // ---- Stage globals ------------------------------------------------------------------------------
 
@@ -70,7 +69,7 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
                   " pixels) but " + m_ctx.deviceName + " has " + mib(have) + ": use a smaller image or a simpler scene");
   }
 
-  m_globals = std::make_unique<StageGlobals>(m_ctx, static_cast<std::uint32_t>(sizeof(StageConstants)));
+  m_globals = std::make_unique<StageGlobals>(m_ctx, STAGE_PUSH_BYTES);
   m_scene = std::make_unique<DeviceScene>(m_ctx, scene);
   m_summary.lights = m_scene->lights();
   m_summary.bvhSeconds = m_scene->bvhSeconds();
@@ -91,10 +90,11 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   m_materials->fillGlobals(g);
   m_film->fillGlobals(g);
   g.display = 0;
-  g.frame.y = settings.seed;
-  g.counts.w = static_cast<std::uint32_t>(settings.lighting);
-  g.options = glm::uvec4(static_cast<std::uint32_t>(settings.rng), static_cast<std::uint32_t>(settings.components),
-                         static_cast<std::uint32_t>(settings.roulette), 0u);
+  g.seed = settings.seed;
+  g.lighting = static_cast<std::uint32_t>(settings.lighting);
+  g.rngMode = static_cast<std::uint32_t>(settings.rng);
+  g.componentChoice = static_cast<std::uint32_t>(settings.components);
+  g.roulette = static_cast<std::uint32_t>(settings.roulette);
   m_camera = scene.hasCamera ? scene.camera : frameScene(scene);
   writeCamera(m_camera);
 
@@ -160,7 +160,7 @@ void Renderer::setCamera(const Camera& camera) {
 
 void Renderer::setLighting(LightingMode mode) {
   m_settings.lighting = mode;
-  m_globals->host().counts.w = static_cast<std::uint32_t>(mode);
+  m_globals->host().lighting = static_cast<std::uint32_t>(mode);
   m_globals->upload();
   reset();
 }

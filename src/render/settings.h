@@ -1,36 +1,100 @@
 // settings.h: what a render is asked to do (RenderSettings and its modes) and what it counted
 // (RenderStats). Shared by the renderer's parts, the render loop and the command line.
+//
+// Every mode is a C++ enum whose values are the shared ids the shaders test (LIGHTING_*,
+// SAMPLER_*, RNG_*, COMPONENTS_*, ROULETTE_* in shaders/shared/), with one name table each: the
+// command line, the EXR header and the messages all take their names from it.
 #pragma once
 #include <cstdint>
 #include <string>
+#include <vector>
+
+#include "../../shaders/shared/bsdf_sampling.h"
+#include "../../shaders/shared/layout.h"
 
 namespace nusselt {
 
-enum class LightingMode : std::uint32_t { Mis = 0, NeeOnly = 1, BsdfOnly = 2 };
-const char* lightingModeName(LightingMode mode);
-// BSDF sampling strategy for non-delta models (SAMPLER_* in shaders/shared/bsdf_sampling.h).
-enum class SamplerKind : std::uint32_t { Quadtree = 0, Cosine = 1, Uniform = 2, Analytic = 3, Tabulated = 4 };
-const char* samplerName(SamplerKind kind);
-// nullptr-safe parse: returns false for an unknown name.
-bool parseSampler(const std::string& name, SamplerKind& kind);
+// A name table entry: an enum value and its name (command line, header).
+template <class E>
+struct EnumName {
+  E value;
+  const char* name;
+};
+
+// The name of `value` in `table` ("?" when absent).
+template <class E, std::size_t N>
+const char* enumName(const EnumName<E> (&table)[N], E value) {
+  for (const EnumName<E>& e : table)
+    if (e.value == value) return e.name;
+  return "?";
+}
+// The value named `name`; false (value untouched) for an unknown name.
+template <class E, std::size_t N>
+bool parseEnum(const EnumName<E> (&table)[N], const std::string& name, E& value) {
+  for (const EnumName<E>& e : table)
+    if (name == e.name) {
+      value = e.value;
+      return true;
+    }
+  return false;
+}
+// Every name of `table`, in its order (for CLI11's IsMember and help texts).
+template <class E, std::size_t N>
+std::vector<std::string> enumNames(const EnumName<E> (&table)[N]) {
+  std::vector<std::string> names;
+  for (const EnumName<E>& e : table) names.push_back(e.name);
+  return names;
+}
+
+// Light transport estimator: MIS (NEE + BSDF sampling), or one of them alone (tests, comparisons).
+enum class LightingMode : std::uint32_t { Mis = LIGHTING_MIS, NeeOnly = LIGHTING_NEE_ONLY, BsdfOnly = LIGHTING_BSDF_ONLY };
+inline constexpr EnumName<LightingMode> kLightingNames[] = {
+    {LightingMode::Mis, "mis"}, {LightingMode::NeeOnly, "nee"}, {LightingMode::BsdfOnly, "bsdf"}};
+
+// BSDF sampling strategy for non-delta models (shaders/shared/bsdf_sampling.h).
+enum class SamplerKind : std::uint32_t {
+  Quadtree = SAMPLER_QUADTREE,  // the generic sampler of Montes et al.
+  Cosine = SAMPLER_COSINE,
+  Uniform = SAMPLER_UNIFORM,
+  Analytic = SAMPLER_ANALYTIC,
+  Tabulated = SAMPLER_TABULATED,
+};
+inline constexpr EnumName<SamplerKind> kSamplerNames[] = {{SamplerKind::Quadtree, "quadtree"},
+                                                          {SamplerKind::Cosine, "cosine"},
+                                                          {SamplerKind::Uniform, "uniform"},
+                                                          {SamplerKind::Analytic, "analytic"},
+                                                          {SamplerKind::Tabulated, "tabulated"}};
 
 // Random numbers: independent PCG hashes, or padded Owen-scrambled Sobol (quasi-Monte Carlo).
-enum class RngMode : std::uint32_t { Pcg = 0, Qmc = 1 };
-const char* rngModeName(RngMode mode);
+enum class RngMode : std::uint32_t { Pcg = RNG_PCG, Qmc = RNG_QMC };
+inline constexpr EnumName<RngMode> kRngNames[] = {{RngMode::Pcg, "pcg"}, {RngMode::Qmc, "qmc"}};
 
-// How a combined material chooses its component at a bounce (COMPONENTS_* in layout.h): albedo =
-// the random-walk source's estimator (probability = the component's albedo for wo, the rest ends
-// the walk); uniform = probability 1/n and a separate albedo roulette (for comparison).
-enum class ComponentSelection : std::uint32_t { Albedo = 0, Uniform = 1 };
-const char* componentSelectionName(ComponentSelection mode);
-bool parseComponentSelection(const std::string& name, ComponentSelection& mode);
+// How a combined material chooses its component at a bounce (shaders/shared/combined.h): albedo
+// = by the component's albedo (the random-walk source's estimator under the albedo roulette, the
+// proportional choice by the largest channel under the throughput roulette); uniform = 1/n.
+enum class ComponentSelection : std::uint32_t { Albedo = COMPONENTS_ALBEDO, Uniform = COMPONENTS_UNIFORM };
+inline constexpr EnumName<ComponentSelection> kComponentNames[] = {{ComponentSelection::Albedo, "albedo"},
+                                                                   {ComponentSelection::Uniform, "uniform"}};
 
 // Russian roulette (ROULETTE_* in layout.h): throughput = continue with the path throughput's
 // largest channel from the third bounce on (the default: never amplifies a channel); albedo = the
 // random-walk source's roulette by the sample's luminance albedo (for comparison).
-enum class RouletteMode : std::uint32_t { Throughput = 0, Albedo = 1 };
-const char* rouletteModeName(RouletteMode mode);
-bool parseRouletteMode(const std::string& name, RouletteMode& mode);
+enum class RouletteMode : std::uint32_t { Throughput = ROULETTE_THROUGHPUT, Albedo = ROULETTE_ALBEDO };
+inline constexpr EnumName<RouletteMode> kRouletteNames[] = {{RouletteMode::Throughput, "throughput"},
+                                                            {RouletteMode::Albedo, "albedo"}};
+
+inline const char* lightingModeName(LightingMode m) { return enumName(kLightingNames, m); }
+inline const char* samplerName(SamplerKind k) { return enumName(kSamplerNames, k); }
+inline const char* rngModeName(RngMode m) { return enumName(kRngNames, m); }
+inline const char* componentSelectionName(ComponentSelection m) { return enumName(kComponentNames, m); }
+inline const char* rouletteModeName(RouletteMode m) { return enumName(kRouletteNames, m); }
+inline bool parseLighting(const std::string& name, LightingMode& m) { return parseEnum(kLightingNames, name, m); }
+inline bool parseSampler(const std::string& name, SamplerKind& k) { return parseEnum(kSamplerNames, name, k); }
+inline bool parseRngMode(const std::string& name, RngMode& m) { return parseEnum(kRngNames, name, m); }
+inline bool parseComponentSelection(const std::string& name, ComponentSelection& m) {
+  return parseEnum(kComponentNames, name, m);
+}
+inline bool parseRouletteMode(const std::string& name, RouletteMode& m) { return parseEnum(kRouletteNames, name, m); }
 
 struct RenderSettings {
   std::uint32_t width = 512;
@@ -58,13 +122,29 @@ struct RenderSettings {
   std::uint32_t maxPathsPerChunk = 1u << 20;
 };
 
+// What the stages counted, summed over passes: one field per entry of NUSSELT_STATS (layout.h).
 struct RenderStats {
-  std::uint64_t rays = 0;
-  std::uint64_t shadowRays = 0;
-  std::uint64_t nonFiniteSamples = 0;
-  std::uint64_t bvhStackOverflows = 0;
-  std::uint64_t samplerBoundViolations = 0;
-  std::uint64_t samplerTrialFailures = 0;
+#define NUSSELT_STAT_FIELD(ID, index, name, what) std::uint64_t name = 0;
+  NUSSELT_STATS(NUSSELT_STAT_FIELD)
+#undef NUSSELT_STAT_FIELD
+
+  // Every counter of `other` added to this one's.
+  void add(const RenderStats& other);
+  // The device's 32-bit counters (the stats buffer, STAT_COUNT uints) added.
+  void addDevice(const std::uint32_t* counters);
+  // Calls f(name, description, value&) for every counter, in the list's order (header, merge).
+  template <class F>
+  void forEach(F&& f) {
+#define NUSSELT_STAT_VISIT(ID, index, name, what) f(#name, what, name);
+    NUSSELT_STATS(NUSSELT_STAT_VISIT)
+#undef NUSSELT_STAT_VISIT
+  }
+  template <class F>
+  void forEach(F&& f) const {
+#define NUSSELT_STAT_VISIT(ID, index, name, what) f(#name, what, name);
+    NUSSELT_STATS(NUSSELT_STAT_VISIT)
+#undef NUSSELT_STAT_VISIT
+  }
 };
 
 }  // namespace nusselt

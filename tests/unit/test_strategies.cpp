@@ -10,6 +10,8 @@
 //     over the cases) plus 2e-4 relative (the quadrature's and float's error).
 #include <gtest/gtest.h>
 
+#include "render/settings.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -249,12 +251,12 @@ TEST(Strategies, AllStrategiesUnbiased) {
     double mean = sum / n, var = std::max(0.0, sum2 / n - mean * mean), se = std::sqrt(var / (n - 1));
     double a = directionalAlbedo(c.id(), p, c.thetaDeg, c.phiDeg);
     double dev = std::abs(mean - a), tol = z * se + 2e-4 * a + 1e-7;
-    static const char* names[] = {"quadtree", "cosine", "uniform", "analytic", "tabulated"};
-    std::printf("%-9s %-42s mean=%.6f albedo=%.6f se=%.2e dev/se=%.2f\n", names[u.strategy], c.name().c_str(), mean, a,
+    const char* name = samplerName(static_cast<SamplerKind>(u.strategy));
+    std::printf("%-9s %-42s mean=%.6f albedo=%.6f se=%.2e dev/se=%.2f\n", name, c.name().c_str(), mean, a,
                 se, se > 0 ? dev / se : 0.0);
     if (dev > tol) {
       ++failures;
-      ADD_FAILURE() << names[u.strategy] << " " << c.name() << ": mean " << mean << " vs albedo " << a << " (se " << se
+      ADD_FAILURE() << name << " " << c.name() << ": mean " << mean << " vs albedo " << a << " (se " << se
                     << ")";
     }
   }
