@@ -440,7 +440,10 @@ bool isMeshoptPlaceholder(const Json& root, const Json& buffer, std::size_t inde
   auto ext = buffer.find("extensions");
   if (ext != buffer.end() && ext->is_object()) {
     auto m = ext->find("EXT_meshopt_compression");
-    if (m != ext->end() && m->is_object() && m->value("fallback", false) == true) return true;
+    if (m != ext->end() && m->is_object()) {
+      auto f = m->find("fallback");
+      if (f != m->end() && f->is_boolean() && f->get<bool>()) return true;
+    }
   }
   auto req = root.find("extensionsRequired");
   if (req == root.end() || !req->is_array()) return false;
