@@ -379,7 +379,7 @@ TEST(GltfTextures, SamplerWrapAndFilterModes) {
     Json j = texturedQuad();
     j["samplers"] = {{{"wrapS", c.wrapS}, {"wrapT", c.wrapT}, {"magFilter", c.mag}, {"minFilter", c.min}}};
     j["textures"][0]["sampler"] = 0;
-    const TextureRef& r = loadJson(j).materials[0].baseColorTexture;
+    const TextureRef r = loadJson(j).materials[0].baseColorTexture;
     EXPECT_EQ(r.wrapS, c.s) << c.wrapS;
     EXPECT_EQ(r.wrapT, c.t) << c.wrapT;
     EXPECT_EQ(r.magFilter, c.fmag) << c.mag;
@@ -481,7 +481,7 @@ TEST(GltfTextures, AlphaSidednessTransmissionIorVolume) {
   // Defaults.
   Json d = texturedQuad();
   d["materials"][0] = Json::parse(R"({"extensions": {"KHR_materials_volume": {}}})");
-  const Material& dm = loadJson(d).materials[0];
+  const Material dm = loadJson(d).materials[0];
   EXPECT_EQ(dm.alphaMode, AlphaMode::Opaque);
   EXPECT_FLOAT_EQ(dm.alphaCutoff, 0.5f);
   EXPECT_FALSE(dm.doubleSided);
