@@ -18,6 +18,8 @@ packages=(
   glslang-tools                              # GLSL -> SPIR-V at build time
   libglfw3-dev libglm-dev                    # window (preview) and vector maths
   libtinygltf-dev nlohmann-json3-dev libstb-dev  # glTF loading
+  libpng-dev libturbojpeg0-dev               # glTF textures: PNG and JPEG decoding
+  libdraco-dev libmeshoptimizer-dev          # glTF compressed geometry (Draco, meshopt)
   libopenexr-dev                             # EXR output
   libcli11-dev                               # command-line parsing
   libgtest-dev                               # tests

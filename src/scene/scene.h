@@ -1,7 +1,9 @@
 // scene.h: the renderer's view of a scene, independent of glTF: world-space triangles with
-// shading normals and a material each, materials (model + parameters + emission), punctual
-// lights and a camera. Built by the glTF loader (gltf_loader.h) or by tests directly.
+// shading normals, texture coordinates, tangents and a material each, materials (model +
+// parameters + emission + textures), decoded texture images, punctual lights and a camera.
+// Built by the glTF loader (gltf_loader.h) or by tests directly.
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -19,6 +21,45 @@ struct MaterialComponent {
   BrdfParams params{};                  // packed by packParams()
 };
 
+// ---- textures (docs/scenes.md, "Textures") ----
+
+// glTF sampler wrap modes (10497, 33071, 33648).
+enum class WrapMode : std::uint32_t { Repeat = 0, ClampToEdge = 1, MirroredRepeat = 2 };
+// Texel filters. glTF's four mipmapped minification filters are reduced to their level filter
+// (NEAREST_MIPMAP_* -> Nearest, LINEAR_MIPMAP_* -> Linear): the images carry no mipmaps.
+enum class FilterMode : std::uint32_t { Nearest = 0, Linear = 1 };
+
+// How a texture's 8-bit code values become numbers: sRGB-encoded colour (baseColor, emissive:
+// decode with the sRGB EOTF) or linear data (metallicRoughness, normal, transmission: v / 255).
+// The same image may be used with either; the image itself has no colour space.
+enum class ColorSpace : std::uint32_t { Linear = 0, Srgb = 1 };
+
+// One decoded image, 8-bit RGBA (4 bytes per texel, row-major, top row first: texture
+// coordinate (0, 0) is the top-left corner of texel (0, 0), (1, 1) the bottom-right corner of the
+// last texel). Decoded once, shared by every texture that uses it.
+struct TextureImage {
+  std::string name;          // the glTF image's name, or its uri, or "images[i]"
+  std::uint32_t source = 0;  // index into the glTF file's images
+  std::uint32_t width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;  // 4 * width * height bytes
+};
+
+// A material's use of a texture: glTF textureInfo + sampler + KHR_texture_transform.
+struct TextureRef {
+  std::int32_t image = -1;  // index into Scene::images; -1: no texture (the factor alone)
+  WrapMode wrapS = WrapMode::Repeat, wrapT = WrapMode::Repeat;
+  FilterMode magFilter = FilterMode::Linear, minFilter = FilterMode::Linear;
+  ColorSpace colorSpace = ColorSpace::Linear;  // set by the slot (see ColorSpace)
+  std::uint32_t texCoord = 0;  // which set: 0 = Scene::texcoords0, 1 = Scene::texcoords1
+  // KHR_texture_transform as a 3x2 matrix (glm: 3 columns of 2 rows): the lookup coordinate is
+  // transform * vec3(uv, 1). Identity without the extension.
+  glm::mat3x2 transform{1.0f};
+
+  bool present() const { return image >= 0; }
+};
+
+enum class AlphaMode : std::uint32_t { Opaque = 0, Mask = 1, Blend = 2 };
+
 struct Material {
   std::string name;
   std::uint32_t model = MODEL_LAMBERT;  // MODEL_* id
@@ -29,9 +70,35 @@ struct Material {
   // params then repeat the first component and are not used for shading.
   std::vector<MaterialComponent> components;
 
+  // ---- glTF 2.0 material data beyond the BRDF parameters (for textures and alpha) ----
+  // The factors as the file gives them (params above hold baseColor clamped to [0, 1]; the
+  // textures multiply these factors). emissiveTexture multiplies `emission`.
+  glm::vec4 baseColorFactor{1.0f};  // RGB linear, A = opacity
+  float metallicFactor = 1.0f, roughnessFactor = 1.0f;
+  TextureRef baseColorTexture;          // sRGB; RGB x baseColorFactor.rgb, A x baseColorFactor.a
+  TextureRef metallicRoughnessTexture;  // linear; G x roughnessFactor, B x metallicFactor
+  TextureRef normalTexture;             // linear; tangent space, needs Scene::tangents
+  float normalScale = 1.0f;             // scales the sampled normal's x and y
+  TextureRef emissiveTexture;           // sRGB; RGB x emission
+  AlphaMode alphaMode = AlphaMode::Opaque;
+  float alphaCutoff = 0.5f;  // MASK: opaque where alpha >= cutoff
+  bool doubleSided = false;
+  // KHR_materials_transmission: fraction of light transmitted (R channel of the texture).
+  float transmissionFactor = 0.0f;
+  TextureRef transmissionTexture;       // linear; R x transmissionFactor
+  // KHR_materials_ior (1.5 without the extension).
+  float ior = 1.5f;
+  // KHR_materials_volume. hasVolume false, or thicknessFactor 0: a thin-walled surface.
+  bool hasVolume = false;
+  float thicknessFactor = 0.0f;
+  float attenuationDistance = INFINITY;  // metres; infinity: no absorption
+  glm::vec3 attenuationColor{1.0f};      // colour after attenuationDistance, in [0, 1]
+
   bool combined() const { return !components.empty(); }
   // Emits light (any channel of the emission above zero): the material's triangles are lights.
   bool emits() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
+  // True when a normal map needs tangents at this material's triangles.
+  bool normalMapped() const { return normalTexture.present(); }
 };
 
 enum class LightType { Point, Spot, Directional };
@@ -65,8 +132,21 @@ struct Scene {
   // Three entries per triangle, world space. Degenerate triangles never get here.
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;       // unit shading normals; the geometric normal where absent
+  // Per triangle corner like positions, or empty when no primitive of the scene has the
+  // attribute. Corners of primitives without it get (0, 0). Finite (non-finite values are
+  // replaced by 0 and counted in a warning).
+  std::vector<glm::vec2> texcoords0;    // TEXCOORD_0, (0, 0) = top-left of the image
+  std::vector<glm::vec2> texcoords1;    // TEXCOORD_1
+  // Per triangle corner, or empty when no primitive has TANGENT and no material has a normal
+  // map. xyz: unit world-space tangent orthogonal to the corner's shading normal (the direction
+  // of increasing u of the normal map's texture coordinate set); w = +1 or -1: the bitangent is
+  // w * cross(normal, tangent). From TANGENT when given, generated for normal-mapped primitives
+  // without it (docs/scenes.md), and an arbitrary tangent perpendicular to the normal (w = +1)
+  // elsewhere.
+  std::vector<glm::vec4> tangents;
   std::vector<std::uint32_t> triangleMaterial;  // one per triangle
   std::vector<Material> materials;
+  std::vector<TextureImage> images;     // decoded once; TextureRef::image indexes this
   std::vector<PunctualLight> lights;
   Camera camera;
   bool hasCamera = false;  // false: the renderer frames the scene with a default view

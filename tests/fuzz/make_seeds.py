@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the generated glTF/GLB seeds of tests/fuzz/corpus/gltf (the others are copies of
-tests/data/gltf, scenes/tests and scenes/cornell-box.glb). Small files that between them reach
+tests/data/gltf, scenes/tests and scenes/cornell-box.glb, or written by tools/make_test_assets.sh). Small files that between them reach
 every branch of the loader: embedded and GLB buffers, strips and fans, index types, normals,
 NUSSELT_brdf (single model and components), lights, cameras, emissive strength, hierarchies."""
 import base64, json, os, struct
@@ -102,6 +102,42 @@ combined = {"materials": [{"name": "glaze", "extensions": {"NUSSELT_brdf": {"com
     {"model": "mirror", "weight": 0.2, "params": {"eta": 0.96, "k": 6.69}}]}}}],
             "extensionsUsed": ["NUSSELT_brdf"]}
 seeds["quad_combined_brdf.gltf"] = scene(quad + normals + idx16, a, v, prim, combined)
+
+# Textures (issue 18): data-URI PNG and JPEG images (the committed test images), a sampler, a
+# texture transform, TEXCOORD_0/1, TANGENT, alpha, transmission, ior and volume.
+IMAGES = os.path.join(os.path.dirname(OUT), "..", "..", "data", "images")
+def image_uri(name, mime):
+    with open(os.path.join(IMAGES, name), "rb") as f:
+        return "data:%s;base64,%s" % (mime, base64.b64encode(f.read()).decode())
+uv = floats(0, 1, 1, 1, 1, 0, 0, 0)
+tangents = floats(*([1, 0, 0, 1] * 4))
+tex_views = views + [{"buffer": 0, "byteOffset": 96, "byteLength": 32}, {"buffer": 0, "byteOffset": 128, "byteLength": 64},
+                     {"buffer": 0, "byteOffset": 192, "byteLength": 12}]
+tex_acc = [pos, nrm, {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+           {"bufferView": 3, "componentType": 5126, "count": 4, "type": "VEC4"},
+           {"bufferView": 4, "componentType": 5123, "count": 6, "type": "SCALAR"}]
+tex_prim = [{"attributes": {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2, "TEXCOORD_1": 2, "TANGENT": 3}, "indices": 4,
+             "material": 0}]
+textured = {
+    "images": [{"uri": image_uri("rgba8.png", "image/png")}, {"uri": image_uri("grey.jpg", "image/jpeg")}],
+    "samplers": [{"magFilter": 9728, "minFilter": 9986, "wrapS": 33648, "wrapT": 33071}],
+    "textures": [{"source": 0, "sampler": 0}, {"source": 1}],
+    "materials": [{"alphaMode": "BLEND", "doubleSided": True,
+                   "pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "extensions": {"KHR_texture_transform": {
+                       "offset": [0.5, 0], "rotation": 0.3, "scale": [2, 2], "texCoord": 1}}},
+                                            "metallicRoughnessTexture": {"index": 1}},
+                   "normalTexture": {"index": 0, "scale": 0.8}, "emissiveTexture": {"index": 1}, "emissiveFactor": [1, 1, 1],
+                   "occlusionTexture": {"index": 1},
+                   "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.5, "transmissionTexture": {"index": 1}},
+                                  "KHR_materials_ior": {"ior": 1.4},
+                                  "KHR_materials_volume": {"thicknessFactor": 0.1, "attenuationDistance": 2,
+                                                           "attenuationColor": [0.5, 0.6, 0.7]}}}],
+    "extensionsUsed": ["KHR_texture_transform", "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"],
+}
+seeds["quad_textured.gltf"] = scene(quad + normals + uv + tangents + idx16, tex_acc, tex_views, tex_prim, textured)
+no_tangent = [dict(tex_prim[0], attributes={"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2})]
+seeds["quad_normal_map_generated_tangents.glb"] = scene(quad + normals + uv + tangents + idx16, tex_acc, tex_views,
+                                                        no_tangent, textured, glb=True)
 
 for name, data in seeds.items():
     with open(os.path.join(OUT, name), "wb") as f:
