@@ -260,8 +260,12 @@ struct Globals {
   BUFREF(TabSets) tabSets;     // tabulated sampler: one set of tables per material (GpuMaterial.info.z)
   BUFREF(TabTables) tabTables;
   BUFREF(Floats) tabData;      // the CDFs of every table
+  // The top-level acceleration structure's device address, low and high 32 bits, for ray queries
+  // (shaders/shared/trace.glsl with NUSSELT_RAY_QUERY); 0 when the GLSL BVH traces.
+  uint tlasLow;
+  uint tlasHigh;
 };
-STATIC_ASSERT_SIZE(Globals, 64 + 6 * 16 + 29 * 8);
+STATIC_ASSERT_SIZE(Globals, 64 + 6 * 16 + 29 * 8 + 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 
@@ -309,6 +313,17 @@ struct SampleToolConstants {
   vec4 v;
 };
 STATIC_ASSERT_SIZE(SampleToolConstants, 32);
+
+// trace_tool (the traversal tests): traces rays 0 .. count - 1 of the shadow-ray arrays (origin,
+// w = tmax; direction) with both scene queries of shared/trace.glsl; writes pathHit = (t, b1, b2,
+// triangle bits) of traceClosest and pathInfo = (traceAny's answer 1 or 0, traceClosest's 1 or 0, 0, 0).
+struct TraceToolConstants {
+  uint count;
+  uint reserved0;
+  uint reserved1;
+  uint reserved2;
+};
+STATIC_ASSERT_SIZE(TraceToolConstants, 16);
 
 // The pipeline layout's push-constant range: the largest of the structs above.
 #define STAGE_PUSH_BYTES 32u

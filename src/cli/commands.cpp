@@ -46,6 +46,7 @@ struct RenderArgs {
   std::string sampler = "quadtree";
   std::string components = "albedo";
   std::string roulette = "throughput";
+  std::string traversal = "auto";
   bool variance = false;
   bool validation = false;
   bool quiet = false;
@@ -77,6 +78,7 @@ int renderCommand(const RenderArgs& a) {
   parseSampler(a.sampler, s.sampler);
   parseComponentSelection(a.components, s.components);
   parseRouletteMode(a.roulette, s.roulette);
+  parseTraversal(a.traversal, s.traversal);
   // Image size: defaults follow the camera's aspect ratio when only one side (or none) is given.
   float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
   s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u);
@@ -121,6 +123,7 @@ int renderCommand(const RenderArgs& a) {
   vk::ContextOptions co;
   co.deviceIndex = a.device;
   co.validation = a.validation || validationFromEnvironment();
+  co.rayQuery = s.traversal != Traversal::Bvh;
   vk::createContext(ctx, co);
   int status = kExitOk;
   {
@@ -140,13 +143,23 @@ int renderCommand(const RenderArgs& a) {
       if (previous.device != ctx.deviceName && !a.quiet)
         std::fprintf(stderr, "warning: %s was rendered on %s; continuing on %s (not bit-identical to an uninterrupted render)\n",
                      a.resume.c_str(), previous.device.c_str(), ctx.deviceName.c_str());
+      else if (previous.settings.traversal != renderer.settings().traversal && !a.quiet)
+        std::fprintf(stderr, "warning: %s was traced with --traversal %s; continuing with %s (not bit-identical to an "
+                             "uninterrupted render)\n",
+                     a.resume.c_str(), traversalName(previous.settings.traversal),
+                     traversalName(renderer.settings().traversal));
       renderer.restoreAccumulation(saved, previous.spp);
       renderer.addStats(previous.stats);
     }
     if (!a.quiet) {
-      std::fprintf(stderr, "scene: %s: %zu triangles, %zu materials (models: %s), %zu lights; BVH %u nodes in %.3f s\n",
-                   scene.sourcePath.c_str(), sum.triangles, sum.materials, models.c_str(), sum.lights, sum.bvhNodes,
-                   sum.bvhSeconds);
+      char structures[128];
+      if (sum.traversal == Traversal::RayQuery)
+        std::snprintf(structures, sizeof structures, "acceleration structures %.1f MiB in %.3f s",
+                      sum.accelerationBytes / 1048576.0, sum.accelerationSeconds);
+      else
+        std::snprintf(structures, sizeof structures, "BVH %u nodes in %.3f s", sum.bvhNodes, sum.bvhSeconds);
+      std::fprintf(stderr, "scene: %s: %zu triangles, %zu materials (models: %s), %zu lights; %s\n",
+                   scene.sourcePath.c_str(), sum.triangles, sum.materials, models.c_str(), sum.lights, structures);
       if (sum.samplerTrees && s.sampler == SamplerKind::Tabulated)
         std::fprintf(stderr, "sampler: %u tabulated tables (%.1f MiB) in %.2f s\n", sum.samplerTrees,
                      sum.samplerBytes / 1048576.0, sum.samplerSeconds);
@@ -156,12 +169,12 @@ int renderCommand(const RenderArgs& a) {
                      sum.samplerCacheMisses, sum.samplerCacheRejected);
       std::string budget = a.timeBudget > 0 ? ", time budget " + std::to_string(a.timeBudget) + " s" : "";
       std::fprintf(stderr, "device: %s (%s); %ux%u, %s spp%s%s, max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
-                           "roulette %s\n",
+                           "roulette %s, traversal %s\n",
                    ctx.deviceName.c_str(), ctx.driverInfo.c_str(), s.width, s.height,
                    targetSpp == (1u << 30) ? "unlimited" : std::to_string(targetSpp).c_str(),
                    a.resume.empty() ? "" : (" (resuming from " + std::to_string(previous.spp) + ")").c_str(),
                    budget.c_str(), s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng),
-                   samplerName(s.sampler), rouletteModeName(s.roulette));
+                   samplerName(s.sampler), rouletteModeName(s.roulette), traversalName(sum.traversal));
     }
 
     base.totalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();  // set-up
@@ -265,9 +278,11 @@ int devicesCommand() {
     return kExitFailure;
   }
   for (const auto& d : devices)
-    std::printf("%u: %s (%s, Vulkan %u.%u, driver %s, %.0f MiB device-local)%s%s\n", d.index, d.name.c_str(),
+    std::printf("%u: %s (%s, Vulkan %u.%u, driver %s, %.0f MiB device-local, %s)%s%s\n", d.index, d.name.c_str(),
                 d.type.c_str(), VK_API_VERSION_MAJOR(d.apiVersion), VK_API_VERSION_MINOR(d.apiVersion),
-                d.driverInfo.c_str(), d.deviceLocalBytes / 1048576.0, d.suitable ? "" : ": not usable: ", d.whyNot.c_str());
+                d.driverInfo.c_str(), d.deviceLocalBytes / 1048576.0,
+                d.rayQuery ? "ray queries" : "no ray queries: BVH traversal", d.suitable ? "" : ": not usable: ",
+                d.whyNot.c_str());
   return kExitOk;
 }
 
@@ -276,7 +291,66 @@ struct BenchArgs {
   std::uint32_t spp = 4;
   std::uint32_t width = 256, height = 256;
   int device = -1;
+  std::vector<std::string> traversals{"auto"};
+  std::uint32_t repeats = 1;
 };
+
+// One timed render of bench render.
+struct BenchRun {
+  double setupSeconds = 0;   // the Renderer: BVH or acceleration structures, quadtrees, pipelines
+  double warmupSeconds = 0;  // the untimed first pass (lavapipe compiles each pipeline at its first dispatch)
+  double seconds = 0;        // the timed passes
+  double samplesPerSecond = 0;
+  double mraysPerSecond = 0;
+  std::vector<std::pair<std::string, double>> stageShare;  // GPU time by stage / seconds
+};
+
+BenchRun benchRenderOnce(vk::Context& ctx, const Scene& scene, const BenchArgs& a, Traversal traversal,
+                         std::size_t& triangles) {
+  RenderSettings s;
+  s.width = a.width;
+  s.height = a.height;
+  s.spp = a.spp;
+  s.timeStages = true;
+  s.traversal = traversal;
+  BenchRun run;
+  auto t0 = std::chrono::steady_clock::now();
+  Renderer r(ctx, scene, s);
+  auto t1 = std::chrono::steady_clock::now();
+  r.renderPass();  // warm-up
+  auto t2 = std::chrono::steady_clock::now();
+  run.setupSeconds = std::chrono::duration<double>(t1 - t0).count();
+  run.warmupSeconds = std::chrono::duration<double>(t2 - t1).count();
+  triangles = r.summary().triangles;
+  std::vector<std::pair<std::string, double>> warm = r.stageSeconds();
+  RenderStats before = r.stats();
+  for (std::uint32_t i = 0; i < a.spp; ++i) r.renderPass();
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
+  RenderStats after = r.stats();
+  double rays = double(after.rays - before.rays + after.shadowRays - before.shadowRays);
+  run.samplesPerSecond = double(a.spp) * s.width * s.height / run.seconds;
+  run.mraysPerSecond = rays / run.seconds / 1e6;
+  for (auto& [name, t] : r.stageSeconds()) {
+    double earlier = 0;
+    for (auto& [n0, t0w] : warm)
+      if (n0 == name) earlier = t0w;
+    run.stageShare.push_back({name, (t - earlier) / run.seconds});
+  }
+  return run;
+}
+
+// "median [min-max]" of the values picked from runs.
+template <class F>
+std::string medianRange(const std::vector<BenchRun>& runs, F pick, const char* format) {
+  std::vector<double> v;
+  for (const BenchRun& r : runs) v.push_back(pick(r));
+  std::sort(v.begin(), v.end());
+  double median = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  char buf[96];
+  std::string f = std::string(format) + " [" + format + "-" + format + "]";
+  std::snprintf(buf, sizeof buf, f.c_str(), median, v.front(), v.back());
+  return buf;
+}
 
 int benchRenderCommand(const BenchArgs& a) {
   std::vector<std::string> scenes = a.scenes;
@@ -286,44 +360,64 @@ int benchRenderCommand(const BenchArgs& a) {
     if (std::filesystem::exists(dragon)) scenes.push_back(dragon);
     else std::fprintf(stderr, "note: %s not found; benchmarking the default scene only\n", dragon.c_str());
   }
+  std::vector<Traversal> traversals;
+  for (const std::string& t : a.traversals) {
+    Traversal v = Traversal::Auto;
+    parseTraversal(t, v);
+    traversals.push_back(v);
+  }
   vk::Context ctx;
   vk::ContextOptions co;
   co.deviceIndex = a.device;
   vk::createContext(ctx, co);
-  std::printf("device: %s\n", ctx.deviceName.c_str());
-  std::printf("%-40s %10s %9s %8s %10s %12s %12s\n", "scene", "triangles", "size", "spp", "seconds", "samples/s",
-              "Mrays/s");
+  std::printf("device: %s (%s), %s\n", ctx.deviceName.c_str(), ctx.driverInfo.c_str(),
+              ctx.rayQuery ? "ray queries" : "no ray queries");
+  std::printf("%u timed spp after one warm-up pass; %u repeat%s, traversals interleaved; setup = BVH or acceleration "
+              "structures, quadtrees, pipelines\n",
+              a.spp, a.repeats, a.repeats == 1 ? "" : "s");
+  std::printf("%-40s %10s %9s %9s %8s %9s %10s %12s %9s\n", "scene", "triangles", "size", "traversal", "setup s",
+              "warm-up s", "seconds", "samples/s", "Mrays/s");
+  char size[32];
+  std::snprintf(size, sizeof size, "%ux%u", a.width, a.height);
   for (const std::string& path : scenes) {
     Scene scene = loadSceneOrDefault(path, "");
-    RenderSettings s;
-    s.width = a.width;
-    s.height = a.height;
-    s.spp = a.spp;
-    s.timeStages = true;
-    Renderer r(ctx, scene, s);
-    r.renderPass();  // warm-up: lavapipe compiles each pipeline at its first dispatch
-    std::vector<std::pair<std::string, double>> warm = r.stageSeconds();
-    RenderStats before = r.stats();
-    auto t0 = std::chrono::steady_clock::now();
-    for (std::uint32_t i = 0; i < a.spp; ++i) r.renderPass();
-    double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    RenderStats after = r.stats();
-    double rays = double(after.rays - before.rays + after.shadowRays - before.shadowRays);
-    double samples = double(a.spp) * s.width * s.height;
-    char size[32];
-    std::snprintf(size, sizeof size, "%ux%u", s.width, s.height);
-    std::printf("%-40s %10zu %9s %8u %10.3f %12.0f %12.3f\n", path.empty() ? "default (cornell-box)" : path.c_str(),
-                r.summary().triangles, size, a.spp, sec, samples / sec, rays / sec / 1e6);
-    std::string stages;
-    for (auto& [name, t] : r.stageSeconds()) {
-      double before = 0;
-      for (auto& [n0, t0] : warm)
-        if (n0 == name) before = t0;
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "%s%s %.1f%%", stages.empty() ? "" : ", ", name.c_str(), 100.0 * (t - before) / sec);
-      stages += buf;
+    const std::string name = path.empty() ? "default (cornell-box)" : path;
+    std::vector<std::vector<BenchRun>> runs(traversals.size());
+    std::vector<Traversal> resolved(traversals.size());
+    std::size_t triangles = 0;
+    for (std::uint32_t rep = 0; rep < a.repeats; ++rep)
+      for (std::size_t k = 0; k < traversals.size(); ++k) {
+        Traversal t = resolveTraversal(ctx, traversals[k]);
+        resolved[k] = t;
+        BenchRun run = benchRenderOnce(ctx, scene, a, t, triangles);
+        std::printf("%-40s %10zu %9s %9s %8.3f %9.3f %10.3f %12.0f %9.3f\n", name.c_str(), triangles, size,
+                    traversalName(t), run.setupSeconds, run.warmupSeconds, run.seconds, run.samplesPerSecond,
+                    run.mraysPerSecond);
+        std::fflush(stdout);
+        runs[k].push_back(std::move(run));
+      }
+    for (std::size_t k = 0; k < traversals.size(); ++k) {
+      const std::vector<BenchRun>& rs = runs[k];
+      if (a.repeats > 1)
+        std::printf("  %s, median [min-max] of %u: setup %s s, warm-up %s s, %s samples/s, %s Mrays/s\n",
+                    traversalName(resolved[k]), a.repeats, medianRange(rs, [](auto& r) { return r.setupSeconds; }, "%.3f").c_str(),
+                    medianRange(rs, [](auto& r) { return r.warmupSeconds; }, "%.3f").c_str(),
+                    medianRange(rs, [](auto& r) { return r.samplesPerSecond; }, "%.0f").c_str(),
+                    medianRange(rs, [](auto& r) { return r.mraysPerSecond; }, "%.3f").c_str());
+      std::string stages;
+      for (std::size_t i = 0; i < rs.front().stageShare.size(); ++i) {
+        const std::string& stage = rs.front().stageShare[i].first;
+        auto share = [&](const BenchRun& r) {
+          for (auto& [n, v] : r.stageShare)
+            if (n == stage) return 100.0 * v;
+          return 0.0;
+        };
+        stages += (stages.empty() ? "" : ", ") + stage + " " + medianRange(rs, share, "%.1f") + "%";
+      }
+      if (!stages.empty())
+        std::printf("  %s, GPU time by stage%s: %s\n", traversalName(resolved[k]), a.repeats > 1 ? " (median [min-max])" : "",
+                    stages.c_str());
     }
-    if (!stages.empty()) std::printf("    GPU time by stage: %s\n", stages.c_str());
   }
   vk::destroyContext(ctx);
   return kExitOk;
@@ -486,6 +580,11 @@ int runCli(int argc, char** argv) {
                                                 "sample's luminance albedo; its survivors' saturated channels grow, "
                                                 "docs/performance.md)")
       ->capture_default_str()->check(CLI::IsMember(enumNames(kRouletteNames)));
+  render->add_option("--traversal", ra.traversal, "Ray traversal: rayquery (the device's ray queries against "
+                                                  "acceleration structures), bvh (the GLSL BVH, every device), auto "
+                                                  "(rayquery on a GPU that offers it, else bvh: on CPU devices such as "
+                                                  "lavapipe the BVH is faster, docs/performance.md)")
+      ->capture_default_str()->check(CLI::IsMember(enumNames(kTraversalNames)));
   render->add_option("--rng", ra.rng, "Random numbers: pcg (independent hashes) or qmc (padded Owen-scrambled Sobol)")
       ->capture_default_str()->check(CLI::IsMember(enumNames(kRngNames)));
   render->add_option("--checkpoint", ra.checkpointSeconds, "Write the image so far to the output every this many seconds "
@@ -507,6 +606,13 @@ int runCli(int argc, char** argv) {
   benchRender->add_option("--width", ba.width, "Image width")->capture_default_str()->check(CLI::Range(1u, 65536u));
   benchRender->add_option("--height", ba.height, "Image height")->capture_default_str()->check(CLI::Range(1u, 65536u));
   benchRender->add_option("--device", ba.device, "Vulkan device index");
+  benchRender->add_option("--traversal", ba.traversals, "Traversals to measure, interleaved within each repeat "
+                                                         "(auto, rayquery, bvh; comma-separated or repeated)")
+      ->capture_default_str()->delimiter(',')->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->check(CLI::IsMember(enumNames(kTraversalNames)));
+  benchRender->add_option("--repeats", ba.repeats, "Repeats of every scene and traversal; with more than one, the "
+                                                   "medians and ranges are printed")
+      ->capture_default_str()->check(CLI::Range(1u, 1000u));
 
   AlbedoArgs aa;
   CLI::App* albedo = app.add_subcommand("albedo", "Directional albedo of a reflectance model (cosine-weighted integral of its "

@@ -1,4 +1,4 @@
-// device_scene.cpp: BVH, triangles, shading data and lights uploaded to the device.
+// device_scene.cpp: BVH or acceleration structures, triangles, shading data and lights on the device.
 #include "render/device_scene.h"
 
 #include <algorithm>
@@ -7,6 +7,7 @@
 
 #include "../../shaders/shared/layout.h"
 #include "scene/bvh.h"
+#include "util/error.h"
 
 namespace nusselt {
 
@@ -31,29 +32,44 @@ std::uint64_t DeviceScene::bytesFor(std::size_t triangles, std::size_t lights) {
          (std::max<std::size_t>(lights, 1)) * (sizeof(GpuLight) + 4) + 4;
 }
 
-DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene) : m_ctx(ctx), m_background(scene.background) {
+DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene, TraversalStructures structures)
+    : m_ctx(ctx), m_background(scene.background) {
   const std::size_t triCount = scene.triangleCount();
   m_triangles = triCount;
+  if (structures.accelerationStructures && !ctx.rayQuery)
+    throw Error("internal: acceleration structures requested on a device without ray queries");
+  if (triCount > UINT32_MAX / 3) throw Error("the scene has more than 2^32 / 3 triangles");
 
-  // ---- BVH (binned SAH) and triangles in BVH order ----
-  auto t0 = std::chrono::steady_clock::now();
-  Bvh bvh = buildBvh(scene.positions);
-  m_bvhSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  m_bvhNodes = static_cast<std::uint32_t>(bvh.nodes.size());
+  // ---- BVH (binned SAH) and triangles in BVH order; ray queries alone need no BVH ----
+  Bvh bvh;
+  if (structures.bvh) {
+    auto t0 = std::chrono::steady_clock::now();
+    bvh = buildBvh(scene.positions);
+    m_bvhSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    m_bvhNodes = static_cast<std::uint32_t>(bvh.nodes.size());
+  }
+  // Triangle order: the BVH's; without one, along a Morton curve, so that builders that split the
+  // primitives in the order given (Mesa 25.0's lavapipe) get a spatially coherent tree: in the
+  // scene's order lavapipe traced the dragon ~200x slower. GPU drivers sort for themselves.
+  std::vector<std::uint32_t> order = structures.bvh ? bvh.triangleOrder : mortonOrder(scene.positions);
 
   // ---- Triangles, shading data and area lights (emitting triangles, by power) ----
   std::vector<GpuTriangle> tris(std::max<std::size_t>(triCount, 1));
   std::vector<GpuTriShading> shading(std::max<std::size_t>(triCount, 1));
   std::vector<GpuLight> lights;
   std::vector<double> weights;
+  std::vector<float> vertices;  // the bottom level's input: 3 vertices per triangle, in g.triangles order
+  if (structures.accelerationStructures) vertices.reserve(9 * triCount);
   glm::vec3 lo(INFINITY), hi(-INFINITY);
   for (std::size_t k = 0; k < triCount; ++k) {
-    std::uint32_t src = bvh.triangleOrder.empty() ? static_cast<std::uint32_t>(k) : bvh.triangleOrder[k];
+    std::uint32_t src = order.empty() ? static_cast<std::uint32_t>(k) : order[k];
     glm::vec3 p0 = scene.positions[3 * src], p1 = scene.positions[3 * src + 1], p2 = scene.positions[3 * src + 2];
     for (glm::vec3 p : {p0, p1, p2}) {
       lo = glm::min(lo, p);
       hi = glm::max(hi, p);
     }
+    if (structures.accelerationStructures)
+      for (glm::vec3 p : {p0, p1, p2}) vertices.insert(vertices.end(), {p.x, p.y, p.z});
     tris[k].v0 = v4(p0);
     tris[k].e1 = v4(p1 - p0);
     tris[k].e2 = v4(p2 - p0);
@@ -133,19 +149,44 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene) : m_ctx(ctx), m_b
     b = vk::createBuffer(m_ctx, bytes, 0, false, what);
     vk::uploadBuffer(m_ctx, b, data, bytes);
   };
-  make(m_bvh, nodes.size() * sizeof(BvhNode), "BVH", nodes.data());
+  if (structures.bvh) make(m_bvh, nodes.size() * sizeof(BvhNode), "BVH", nodes.data());
   make(m_tris, tris.size() * sizeof(GpuTriangle), "triangle", tris.data());
   make(m_shading, shading.size() * sizeof(GpuTriShading), "triangle shading", shading.data());
   make(m_lightBuffer, lights.size() * sizeof(GpuLight), "light", lights.data());
   make(m_lightCdf, cdf.size() * sizeof(float), "light CDF", cdf.data());
+
+  // ---- Acceleration structures: one bottom level over all triangles (the scene is flattened to
+  // world space), one top-level instance of it. Primitive i is triangle i of g.triangles. ----
+  if (structures.accelerationStructures && triCount > 0) {
+    auto t0 = std::chrono::steady_clock::now();
+    vk::Buffer input = vk::createBuffer(m_ctx, vertices.size() * sizeof(float),
+                                        VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR, false,
+                                        "acceleration structure vertex");
+    try {
+      vk::uploadBuffer(m_ctx, input, vertices.data(), vertices.size() * sizeof(float));
+      m_blas = vk::buildBottomLevel(m_ctx, input, static_cast<std::uint32_t>(triCount));
+      m_tlas = vk::buildTopLevel(m_ctx, m_blas);
+    } catch (...) {
+      vk::destroyBuffer(m_ctx, input);
+      release();  // the constructor does not complete: the destructor will not run
+      throw;
+    }
+    // The structures hold their own copy of the geometry.
+    vk::destroyBuffer(m_ctx, input);
+    m_accelSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
 }
 
-DeviceScene::~DeviceScene() {
+DeviceScene::~DeviceScene() { release(); }
+
+void DeviceScene::release() {
+  vk::destroyAccelerationStructure(m_ctx, m_tlas);
+  vk::destroyAccelerationStructure(m_ctx, m_blas);
   for (vk::Buffer* b : {&m_bvh, &m_tris, &m_shading, &m_lightBuffer, &m_lightCdf}) vk::destroyBuffer(m_ctx, *b);
 }
 
 std::uint64_t DeviceScene::deviceBytes() const {
-  return m_bvh.size + m_tris.size + m_shading.size + m_lightBuffer.size + m_lightCdf.size;
+  return m_bvh.size + m_tris.size + m_shading.size + m_lightBuffer.size + m_lightCdf.size + accelerationBytes();
 }
 
 void DeviceScene::fillGlobals(shared::Globals& g) const {
@@ -158,6 +199,8 @@ void DeviceScene::fillGlobals(shared::Globals& g) const {
   g.background = v4(m_background);
   g.lightCount = static_cast<std::uint32_t>(m_lights);
   g.triangleCount = static_cast<std::uint32_t>(m_triangles);
+  g.tlasLow = static_cast<std::uint32_t>(m_tlas.address);
+  g.tlasHigh = static_cast<std::uint32_t>(m_tlas.address >> 32);
 }
 
 }  // namespace nusselt
