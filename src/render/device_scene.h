@@ -48,6 +48,8 @@ class DeviceScene {
   double accelerationSeconds() const { return m_accelSeconds; }
   std::uint64_t accelerationBytes() const { return m_blas.buffer.size + m_tlas.buffer.size; }
   std::uint64_t deviceBytes() const;
+  // The triangles as the stages see them (g.triangles: v0, e1, e2 in BVH or Morton order).
+  const vk::Buffer& triangleBuffer() const { return m_tris; }
   // Bounding sphere of the triangles (centre, radius; radius 1 without triangles).
   glm::vec4 boundingSphere() const { return m_sphere; }
 
