@@ -247,6 +247,11 @@ int mergeCommand(const std::vector<std::string>& inputs, const std::string& outp
       const std::string d = firstDifference(merged, r);
       if (!d.empty()) throw Error(inputs[k] + ": " + d + " (" + inputs[0] + " vs this file): only renders of the same "
                                   "scene and settings can be merged");
+      if (r.settings.traversal != merged.settings.traversal)
+        std::fprintf(stderr, "note: %s was traced with --traversal %s, %s with %s (both estimate the same image); the "
+                             "merged header names %s\n",
+                     inputs[k].c_str(), traversalName(r.settings.traversal), inputs[0].c_str(),
+                     traversalName(merged.settings.traversal), traversalName(merged.settings.traversal));
       for (std::size_t i = 0; i < total.sum.size(); ++i) {
         total.sum[i] += img.sum[i];
         total.sumSq[i] += img.sumSq[i];

@@ -33,8 +33,9 @@ class DeviceScene {
   DeviceScene& operator=(const DeviceScene&) = delete;
 
   // Device bytes the scene's buffers take for this many triangles and lights (before anything is
-  // allocated: the render refuses early when it cannot fit).
-  static std::uint64_t bytesFor(std::size_t triangles, std::size_t lights);
+  // allocated: the render refuses early when it cannot fit), with the BVH or, when
+  // accelerationStructures, an estimate of the acceleration structures and their build input.
+  static std::uint64_t bytesFor(std::size_t triangles, std::size_t lights, bool accelerationStructures = false);
 
   // Buffer addresses, light count and distribution, scene bounds and background in the globals.
   void fillGlobals(shared::Globals& g) const;

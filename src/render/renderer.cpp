@@ -63,7 +63,8 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
     std::size_t lightBound = scene.lights.size();
     for (std::uint32_t m : scene.triangleMaterial) lightBound += scene.materials[m].emits() ? 1 : 0;
     const std::uint32_t capacity = PathIntegrator::capacityFor(settings, pixels);
-    const std::uint64_t need = DeviceScene::bytesFor(scene.triangleCount(), lightBound) +
+    const std::uint64_t need = DeviceScene::bytesFor(scene.triangleCount(), lightBound,
+                                                     m_settings.traversal == Traversal::RayQuery) +
                                std::max<std::size_t>(scene.materials.size(), 1) * sizeof(shared::GpuMaterial) +
                                Film::bytesFor(pixels) + PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS);
     const std::uint64_t have = vk::deviceLocalHeapSize(m_ctx);
