@@ -59,7 +59,9 @@ median() { sort -g | awk '{v[NR] = $1} END {m = NR % 2 ? v[(NR + 1) / 2] : (v[NR
       done
     done
     for t in bvh rayquery; do
-      echo "| ${scene:+$(basename "$scene")}${scene:-cornell-box (built in)} | $t | $(median <"$work/wall_$t") |" \
+      name="cornell-box (built in)"
+      [ -n "$scene" ] && name=$(basename "$scene")
+      echo "| $name | $t | $(median <"$work/wall_$t") |" \
            "$(median <"$work/build_$t") |"
       rm -f "$work/wall_$t" "$work/build_$t"
     done

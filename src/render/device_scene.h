@@ -44,8 +44,8 @@ class DeviceScene {
   std::size_t lights() const { return m_lights; }
   std::uint32_t bvhNodes() const { return m_bvhNodes; }
   double bvhSeconds() const { return m_bvhSeconds; }
-  // The acceleration structures: build time (vertex upload and both levels) and device bytes;
-  // 0 when not built.
+  // The acceleration structures: build time (the Morton order when there is no BVH, the vertex
+  // upload and both levels) and device bytes; 0 when not built.
   double accelerationSeconds() const { return m_accelSeconds; }
   std::uint64_t accelerationBytes() const { return m_blas.buffer.size + m_tlas.buffer.size; }
   std::uint64_t deviceBytes() const;
