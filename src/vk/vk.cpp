@@ -451,9 +451,8 @@ void destroyBuffer(Context& ctx, Buffer& b) {
 
 namespace {
 
-// Creates the structure's buffer and handle for `size` bytes, and a scratch buffer of
-// `scratchSize` whose address is aligned for the build (the allocation is padded so that an
-// aligned address lies inside it). `what` names both in out-of-memory errors.
+// Creates the structure's buffer (device-local, with a device address) and handle for `size`
+// bytes. `what` names it in out-of-memory errors.
 AccelerationStructure createAccelerationStructure(Context& ctx, VkAccelerationStructureTypeKHR type, VkDeviceSize size,
                                                   const std::string& what) {
   AccelerationStructure as;
@@ -473,7 +472,8 @@ AccelerationStructure createAccelerationStructure(Context& ctx, VkAccelerationSt
   return as;
 }
 
-// Sizes, allocation and the build of one structure from one geometry; waits for it.
+// Sizes, allocation and the build of one structure from one geometry; waits for it. The scratch
+// buffer is padded by the device's scratch alignment so that an aligned address lies inside it.
 AccelerationStructure buildOne(Context& ctx, VkAccelerationStructureTypeKHR type,
                                const VkAccelerationStructureGeometryKHR& geometry, std::uint32_t primitives,
                                const std::string& what) {
