@@ -381,9 +381,9 @@ RenderResult renderTimed(vk::Context& ctx, const Scene& scene, RenderSettings s)
   r.renderPass();  // warm-up: lavapipe compiles each pipeline at its first dispatch
   r.reset();
   auto t0 = std::chrono::steady_clock::now();
-  for (std::uint32_t i = 0; i < s.spp; ++i) {
+  while (r.samplesDone() < s.spp) {
     if (g_stopSignal) throw Error("interrupted");
-    r.renderPass();
+    r.renderPass(s.spp - r.samplesDone());
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.image = r.image(true);

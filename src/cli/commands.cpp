@@ -2,6 +2,7 @@
 #include "cli/commands.h"
 
 #include <CLI/CLI.hpp>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <thread>
 
 #include "brdf/albedo.h"
 #include "cli/cli_common.h"
@@ -40,6 +42,7 @@ struct RenderArgs {
   std::uint32_t seed = 0;
   std::uint32_t sppOffset = 0;
   std::uint32_t maxDepth = 8;
+  std::uint32_t samplesPerPass = 0;
   int device = -1;
   std::string lighting = "mis";
   std::string rng = "pcg";
@@ -72,6 +75,7 @@ int renderCommand(const RenderArgs& a) {
   s.seed = a.seed;
   s.maxDepth = a.maxDepth;
   s.sampleOffset = a.sppOffset;
+  s.samplesPerPass = a.samplesPerPass;
   parseLighting(a.lighting, s.lighting);
   parseRngMode(a.rng, s.rng);
   parseSampler(a.sampler, s.sampler);
@@ -155,12 +159,12 @@ int renderCommand(const RenderArgs& a) {
                      sum.samplerTrees, sum.samplerBytes / 1048576.0, sum.samplerSeconds, sum.samplerCacheHits,
                      sum.samplerCacheMisses, sum.samplerCacheRejected);
       std::string budget = a.timeBudget > 0 ? ", time budget " + std::to_string(a.timeBudget) + " s" : "";
-      std::fprintf(stderr, "device: %s (%s); %ux%u, %s spp%s%s, max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
+      std::fprintf(stderr, "device: %s (%s); %ux%u, %s spp%s%s (%u per pass), max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
                            "roulette %s\n",
                    ctx.deviceName.c_str(), ctx.driverInfo.c_str(), s.width, s.height,
                    targetSpp == (1u << 30) ? "unlimited" : std::to_string(targetSpp).c_str(),
                    a.resume.empty() ? "" : (" (resuming from " + std::to_string(previous.spp) + ")").c_str(),
-                   budget.c_str(), s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng),
+                   budget.c_str(), renderer.samplesPerPass(), s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng),
                    samplerName(s.sampler), rouletteModeName(s.roulette));
     }
 
@@ -273,11 +277,24 @@ int devicesCommand() {
 
 struct BenchArgs {
   std::vector<std::string> scenes;
-  std::uint32_t spp = 4;
+  std::uint32_t spp = 16;
   std::uint32_t width = 256, height = 256;
+  std::uint32_t maxDepth = 8;
+  std::uint32_t samplesPerPass = 0;
   int device = -1;
 };
 
+double cpuSecondsUsed() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+// Throughput of the path tracer: for each scene, samples/s and rays/s over `spp` samples per
+// pixel after a warm-up pass (lavapipe compiles a pipeline at its first dispatch), the CPU time
+// the process used per second of wall time (a CPU device should keep every core busy), GPU time
+// per stage and per shade pipeline (timestamps; a barrier after each shade pipeline in this
+// mode), and the extension rays per bounce (the queue sizes the wavefront works through).
 int benchRenderCommand(const BenchArgs& a) {
   std::vector<std::string> scenes = a.scenes;
   if (scenes.empty()) {
@@ -290,40 +307,68 @@ int benchRenderCommand(const BenchArgs& a) {
   vk::ContextOptions co;
   co.deviceIndex = a.device;
   vk::createContext(ctx, co);
-  std::printf("device: %s\n", ctx.deviceName.c_str());
-  std::printf("%-40s %10s %9s %8s %10s %12s %12s\n", "scene", "triangles", "size", "spp", "seconds", "samples/s",
-              "Mrays/s");
+  std::printf("device: %s (%s), %u CPU threads\n", ctx.deviceName.c_str(), ctx.driverInfo.c_str(),
+              std::thread::hardware_concurrency());
+  std::printf("%-34s %9s %9s %5s %6s %8s %11s %8s %9s\n", "scene", "triangles", "size", "spp", "spp/pass", "seconds",
+              "samples/s", "Mrays/s", "CPU cores");
   for (const std::string& path : scenes) {
     Scene scene = loadSceneOrDefault(path, "");
     RenderSettings s;
     s.width = a.width;
     s.height = a.height;
     s.spp = a.spp;
+    s.maxDepth = a.maxDepth;
+    s.samplesPerPass = a.samplesPerPass;
     s.timeStages = true;
     Renderer r(ctx, scene, s);
-    r.renderPass();  // warm-up: lavapipe compiles each pipeline at its first dispatch
-    std::vector<std::pair<std::string, double>> warm = r.stageSeconds();
-    RenderStats before = r.stats();
-    auto t0 = std::chrono::steady_clock::now();
-    for (std::uint32_t i = 0; i < a.spp; ++i) r.renderPass();
-    double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    RenderStats after = r.stats();
-    double rays = double(after.rays - before.rays + after.shadowRays - before.shadowRays);
-    double samples = double(a.spp) * s.width * s.height;
+    r.renderPass(1);  // warm-up: lavapipe compiles each pipeline at its first dispatch
+    const std::vector<std::pair<std::string, double>> warm = r.stageSeconds();
+    const std::vector<std::uint64_t> warmRays = r.raysPerBounce();
+    const RenderStats before = r.stats();
+    const double cpu0 = cpuSecondsUsed();
+    const auto t0 = std::chrono::steady_clock::now();
+    r.render(1 + a.spp);
+    const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double cpu = cpuSecondsUsed() - cpu0;
+    const RenderStats after = r.stats();
+    const double rays = double(after.rays - before.rays + after.shadowRays - before.shadowRays);
+    const double samples = double(a.spp) * s.width * s.height;
     char size[32];
     std::snprintf(size, sizeof size, "%ux%u", s.width, s.height);
-    std::printf("%-40s %10zu %9s %8u %10.3f %12.0f %12.3f\n", path.empty() ? "default (cornell-box)" : path.c_str(),
-                r.summary().triangles, size, a.spp, sec, samples / sec, rays / sec / 1e6);
-    std::string stages;
+    std::printf("%-34s %9zu %9s %5u %6u %8.3f %11.0f %8.3f %9.2f\n",
+                path.empty() ? "default (cornell-box)" : std::filesystem::path(path).filename().c_str(),
+                r.summary().triangles, size, a.spp, r.samplesPerPass(), sec, samples / sec, rays / sec / 1e6, cpu / sec);
+    double gpu = 0;
+    std::vector<std::pair<std::string, double>> timed;
     for (auto& [name, t] : r.stageSeconds()) {
-      double before = 0;
-      for (auto& [n0, t0] : warm)
-        if (n0 == name) before = t0;
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "%s%s %.1f%%", stages.empty() ? "" : ", ", name.c_str(), 100.0 * (t - before) / sec);
-      stages += buf;
+      double w = 0;
+      for (auto& [n0, t0s] : warm)
+        if (n0 == name) w = t0s;
+      timed.push_back({name, t - w});
+      gpu += t - w;
     }
-    if (!stages.empty()) std::printf("    GPU time by stage: %s\n", stages.c_str());
+    if (gpu > 0) {
+      std::string stages, shades;
+      for (auto& [name, t] : timed) {
+        char buf[96];
+        const bool shade = name.rfind("shade ", 0) == 0;
+        std::snprintf(buf, sizeof buf, "%s%s %.1f%%", (shade ? shades : stages).empty() ? "" : ", ",
+                      shade ? name.c_str() + 6 : name.c_str(), 100.0 * t / gpu);
+        (shade ? shades : stages) += buf;
+      }
+      std::printf("    GPU time %.3f s by stage: %s\n", gpu, stages.c_str());
+      if (!shades.empty()) std::printf("    shade pipelines (model: share of GPU time): %s\n", shades.c_str());
+    }
+    std::string perBounce;
+    const std::vector<std::uint64_t>& bounces = r.raysPerBounce();
+    for (std::size_t b = 0; b < bounces.size(); ++b) {
+      const std::uint64_t n = bounces[b] - (b < warmRays.size() ? warmRays[b] : 0);
+      if (n == 0) continue;
+      char buf[48];
+      std::snprintf(buf, sizeof buf, "%s%zu:%.3g", perBounce.empty() ? "" : " ", b, double(n) / samples);
+      perBounce += buf;
+    }
+    std::printf("    paths per sample alive at bounce (bounce:fraction): %s\n", perBounce.c_str());
   }
   vk::destroyContext(ctx);
   return kExitOk;
@@ -376,6 +421,7 @@ int benchPipelinesCommand(int device) {
     RenderSettings s;
     s.width = s.height = 32;
     s.maxDepth = 2;
+    s.samplesPerPass = 1;  // the second pass times one sample per pixel
     auto t0 = std::chrono::steady_clock::now();
     Renderer r(ctx, scene, s);
     double create = r.summary().pipelineSeconds;
@@ -459,6 +505,10 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
   render->add_option("--max-depth", ra.maxDepth, "Maximum path depth (0: emitted light only, 1: direct lighting)")
       ->capture_default_str()->check(CLI::Range(0u, 1024u));
+  render->add_option("--samples-per-pass", ra.samplesPerPass,
+                     "Samples per pixel traced together in one pass (0: enough for about 2^18 paths in flight on a "
+                     "CPU device, 2^21 on a GPU, at most 64); the image does not depend on it")
+      ->capture_default_str()->check(CLI::Range(0u, 4096u));
   render->add_option("--png", ra.png, "Also write a tone-mapped sRGB PNG");
   render->add_option("--exposure", ra.exposure, "Exposure of the PNG, in stops")->capture_default_str();
   render->add_option("--camera", ra.camera, "Use the glTF camera with this name (default: the first camera)");
@@ -506,6 +556,11 @@ int runCli(int argc, char** argv) {
       ->check(CLI::Range(1u, 1u << 20));
   benchRender->add_option("--width", ba.width, "Image width")->capture_default_str()->check(CLI::Range(1u, 65536u));
   benchRender->add_option("--height", ba.height, "Image height")->capture_default_str()->check(CLI::Range(1u, 65536u));
+  benchRender->add_option("--max-depth", ba.maxDepth, "Maximum path depth")->capture_default_str()
+      ->check(CLI::Range(0u, 1024u));
+  benchRender->add_option("--samples-per-pass", ba.samplesPerPass,
+                          "Samples per pixel per pass (0: chosen for the device, as render does)")
+      ->capture_default_str()->check(CLI::Range(0u, 4096u));
   benchRender->add_option("--device", ba.device, "Vulkan device index");
 
   AlbedoArgs aa;

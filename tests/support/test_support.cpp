@@ -68,7 +68,7 @@ void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::
 
 Rendered render(const Scene& scene, const RenderSettings& settings) {
   Renderer r(context(), scene, settings);
-  for (std::uint32_t i = 0; i < settings.spp; ++i) r.renderPass();
+  r.render(settings.spp);
   return {r.image(true), r.stats(), r.summary()};
 }
 
