@@ -57,6 +57,8 @@ class MaterialTable {
   vk::Buffer m_materials, m_components;
   vk::Buffer m_quadSets, m_quadTables, m_quadNodes, m_quadLeaves;
   vk::Buffer m_tabSets, m_tabTables, m_tabData;
+  vk::Buffer m_measured;  // measured BRDF tables (merl), MERL_TABLE_FLOATS floats each
+  std::uint32_t m_measuredTables = 0;
 };
 
 }  // namespace nusselt

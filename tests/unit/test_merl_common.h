@@ -1,0 +1,80 @@
+// test_merl_common.h: MERL files written at test time from analytic models (tools/make_merl.cpp's
+// code path: tabulateMerl + writeMerlFile) and the measured sampler's case matrix, shared by
+// tests/unit/test_merl.cpp (CPU) and tests/gpu/test_merl_gpu.cpp (GPU).
+#pragma once
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "brdf/merl.h"
+#include "brdf/registry.h"
+#include "test_quadtree_chi2.h"
+
+namespace nusselt::merltest {
+
+using namespace shared;
+
+// The two tabulated materials of the tests: Lambert rho = 0.5 (the albedo test of issue 20) and
+// torrance_sparrow's typical set (kd 0.3, ks 0.7, Beckmann m = 0.2, eta 1.5: a glossy lobe).
+struct Source {
+  std::string name;   // "lambert05" or "glossy"
+  std::string model;  // the analytic model tabulated
+  NamedParams params;
+};
+inline std::vector<Source> sources() {
+  const ModelSpec* ts = findModel("torrance_sparrow");
+  return {{"lambert05", "lambert", {{"rho", ParamValue::num(0.5)}}}, {"glossy", "torrance_sparrow", typicalParams(*ts)}};
+}
+
+inline std::string tempDir() {
+  static const std::string dir = [] {
+    std::filesystem::path d = std::filesystem::temp_directory_path() / ("nusselt-merl-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(d);
+    return d.string();
+  }();
+  return dir;
+}
+
+// The file written from `s` (once per process) and its merl parameter block.
+inline std::string fileFor(const Source& s) {
+  std::string path = tempDir() + "/" + s.name + ".binary";
+  if (!std::filesystem::exists(path)) {
+    const ModelSpec* m = findModel(s.model);
+    writeMerlFile(path, tabulateMerl(m->id, packParams(*m, s.params, s.name)));
+  }
+  return path;
+}
+inline BrdfParams merlParams(const Source& s) { return loadMerl(fileFor(s), s.name); }
+inline BrdfParams analyticParams(const Source& s) {
+  const ModelSpec* m = findModel(s.model);
+  return packParams(*m, s.params, s.name);
+}
+
+struct Case {
+  Source source;
+  double thetaDeg;
+  std::string name() const {
+    char b[96];
+    std::snprintf(b, sizeof b, "merl(%s)/theta=%.1f", source.name.c_str(), thetaDeg);
+    return b;
+  }
+};
+// 0, 30, 60, 85 degrees (on tables) and 37.3 (between two) for both files.
+inline std::vector<Case> caseMatrix() {
+  std::vector<Case> cases;
+  for (const Source& s : sources())
+    for (double t : {0.0, 30.0, 60.0, 85.0, 37.3}) cases.push_back({s, t});
+  return cases;
+}
+// Bonferroni: significance 0.01 over the measured cases, CPU and GPU.
+inline double suiteAlpha() { return 0.01 / (2.0 * double(caseMatrix().size())); }
+inline vec3 knownDirection(double thetaDeg) {
+  double th = thetaDeg * M_PI / 180;
+  return vec3(float(std::sin(th)), 0.0f, float(std::cos(th)));
+}
+
+}  // namespace nusselt::merltest
