@@ -180,6 +180,11 @@ BrdfParams loadMerl(const std::string& path, const std::string& displayName) {
   for (std::size_t n = 0; n < MERL_NODES; ++n)
     table->luminance[n] = std::max(0.0f, luminance(vec3(table->rgb[3 * n], table->rgb[3 * n + 1], table->rgb[3 * n + 2])));
   buildPyramid(*table);
+  table->maxOverPhi.assign(std::size_t(kH) * kD, 0.0f);
+  for (std::size_t n = 0; n < MERL_NODES; ++n) {
+    float& m = table->maxOverPhi[n / kP];
+    m = std::max(m, table->luminance[n]);
+  }
 
   std::lock_guard<std::mutex> lock(g_storeMutex);
   if (g_store.size() >= MERL_MAX_TABLES)

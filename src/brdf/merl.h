@@ -21,6 +21,7 @@ struct MerlTable {
   std::uint32_t unmeasured = 0;   // nodes with a negative ("not measured") entry, filled on load
   std::vector<float> rgb;         // MERL_TABLE_FLOATS: the shared code's layout
   std::vector<float> luminance;   // MERL_NODES: luminance of each node (the builder's bounds)
+  std::vector<float> maxOverPhi;  // 90 x 90: max over phi_d of `luminance` at each (theta_h, theta_d) node
   // Maxima of `luminance` over aligned blocks of 2^L nodes per axis, L = 1.. (merlNodeMax).
   std::vector<std::vector<float>> pyramid;
   std::uint32_t pyramidDims[8][3] = {};

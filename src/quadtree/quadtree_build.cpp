@@ -344,6 +344,20 @@ double merlBoxMax(const MerlTable& t, Interval uh, Interval ud, Interval up) {
   static thread_local std::vector<double> A, B, C;
   axis(uh, A);
   axis(ud, B);
+  if (up.hi - up.lo >= 179 && A.size() * B.size() <= 4096) {
+    // Every phi_d: the interpolant at (u_h, u_d) is at most the bilinear interpolation of the
+    // nodes' maxima over phi_d, whose maximum over the box is on its grid.
+    auto M = [&](int i, int j) { return double(t.maxOverPhi[std::size_t(i) * 90 + std::size_t(j)]); };
+    double m = 0;
+    for (double a : A)
+      for (double b : B) {
+        int i0 = std::min(int(a), 88), j0 = std::min(int(b), 88);
+        double fi = a - i0, fj = b - j0;
+        double c0 = M(i0, j0) + fj * (M(i0, j0 + 1) - M(i0, j0)), c1 = M(i0 + 1, j0) + fj * (M(i0 + 1, j0 + 1) - M(i0 + 1, j0));
+        m = std::max(m, c0 + fi * (c1 - c0));
+      }
+    return m;
+  }
   axis(up, C);
   if (A.size() * B.size() * C.size() > 512)
     return merlNodeMax(t, int(uh.lo), int(uh.hi) + 1, int(ud.lo), int(ud.hi) + 1, int(std::floor(up.lo)),
@@ -359,6 +373,9 @@ double merlBoxMax(const MerlTable& t, Interval uh, Interval ud, Interval up) {
 // cos theta; v fixed, v.z >= 0).
 double merlRegionBound(const MerlTable& t, vec3 v, Interval x, Interval y, Interval z) {
   const double vx = v.x, vy = v.y, vz = v.z;
+  // f(., v) is symmetric in w.y for v.y = 0 (isotropic): bound over |w.y| (a padded polar box
+  // reaches 1e-6 below the seam y = 0).
+  if (vy == 0 && y.lo < 0) y = y.hi <= 0 ? Interval{-y.hi, -y.lo} : Interval{0, std::max(-y.lo, y.hi)};
   // Widening of the table coordinates: covers the float rounding of the shared evaluation.
   const double pad = 0.01;
   Interval d = vx * x + vy * y + vz * z;  // w . v
@@ -366,40 +383,45 @@ double merlRegionBound(const MerlTable& t, vec3 v, Interval x, Interval y, Inter
   // cos theta_d = |w + v| / 2 = sqrt((1 + w.v) / 2)
   Interval cd = sqrtI({(1 + d.lo) / 2, (1 + d.hi) / 2});
   Interval thetaD = {std::acos(std::min(cd.hi, 1.0)), std::acos(std::min(cd.lo, 1.0))};
-  Interval sNorm = sqrtI({2 + 2 * d.lo, 2 + 2 * d.hi});  // |w + v|
+  // theta_h = atan(rho / (w.z + v.z)), rho = |(w + v)_xy|: numerator and denominator depend on
+  // different coordinates, so the quotient's interval is tight (cos theta_h = (w.z + v.z) / |w + v|
+  // would tie both to w and, near w = -v, lose degrees to the box's corners off the sphere).
+  Interval rhoH = sqrtI(sq(x + Interval{vx, vx}) + sq(y + Interval{vy, vy}));
   Interval zv = z + Interval{vz, vz};
-  Interval ch = sNorm.lo > 1e-12 ? divPos(zv, sNorm) : Interval{0, 1};
-  ch = {std::clamp(ch.lo, 0.0, 1.0), std::clamp(ch.hi, 0.0, 1.0)};
-  Interval thetaH = {std::acos(ch.hi), std::acos(ch.lo)};
+  Interval thetaH = {0, M_PI / 2};
+  if (zv.lo > 0) thetaH = {std::atan(rhoH.lo / zv.hi), std::atan(rhoH.hi / zv.lo)};
+  else if (zv.hi > 0) thetaH = {std::atan(rhoH.lo / zv.hi), M_PI / 2};
   const double k = 2 / M_PI;
   Interval uh = {90 * std::sqrt(thetaH.lo * k) - pad, 90 * std::sqrt(thetaH.hi * k) + pad};
   Interval ud = {90 * thetaD.lo * k - pad, 90 * thetaD.hi * k + pad};
   Interval up = {0, 180};
-  // phi_d = atan2(Y, X) with (the coordinates of w in the half-vector frame, times sin theta_d)
-  //   rho = |(w + v)_xy|, Y = (v.x w.y - v.y w.x) / rho,
-  //   X = ((w.z + v.z)(r^2 + v.x w.x + v.y w.y) - rho^2 w.z) / (|w + v| rho).
+  // phi_d: w = cos(theta_d) h + sin(theta_d) (cos(phi_d) t + sin(phi_d) b) with t.z = -sin(theta_h),
+  // so w.z = cos(theta_d) cos(theta_h) - sin(theta_d) sin(theta_h) cos(phi_d); cos(theta_d)
+  // cos(theta_h) = (w.z + v.z) / 2, sin(theta_d) sin(theta_h) = rho sqrt((1 - w.v) / (1 + w.v)) / 2
+  // with rho = |(w + v)_xy|:  cos(phi_d) = (v.z - w.z) / (rho sqrt((1 - w.v) / (1 + w.v))).
+  // The sets of an isotropic model have v.y = 0, v.x >= 0 and w.y >= 0 (half disc), where
+  // sin(phi_d) = v.x w.y / (rho sin(theta_d)) >= 0: phi_d = acos(cos(phi_d)) in [0, pi].
   Interval wx = x + Interval{vx, vx}, wy = y + Interval{vy, vy};
-  Interval rho2 = sq(wx) + sq(wy);
-  if (rho2.lo > 1e-10 && sNorm.lo > 1e-6 && thetaD.lo > 1e-6) {
-    Interval rho = sqrtI(rho2);
-    Interval r2 = sq(x) + sq(y);
-    Interval Y = divPos(vx * y - vy * x, rho);
-    Interval X = divPos(zv * (r2 + vx * x + vy * y) - rho2 * z, sNorm * rho);
-    bool origin = X.lo <= 0 && X.hi >= 0 && Y.lo <= 0 && Y.hi >= 0;
-    if (!origin) {
-      bool wrap = X.hi < 0 && Y.lo < 0 && Y.hi > 0;  // straddles the negative X axis
-      double lo = 1e9, hi = -1e9;
-      for (double a : {X.lo, X.hi})
-        for (double b : {Y.lo, Y.hi}) {
-          double ang = std::atan2(b, a);
-          if (wrap && ang < 0) ang += 2 * M_PI;
-          lo = std::min(lo, ang);
-          hi = std::max(hi, ang);
+  Interval rho = sqrtI(sq(wx) + sq(wy));
+  if (vy == 0 && y.lo >= 0 && rho.lo > 1e-9 && d.hi < 1 - 1e-12 && d.lo > -1 + 1e-12) {
+    Interval ratio = sqrtI(divPos({1 - d.hi, 1 - d.lo}, {1 + d.lo, 1 + d.hi}));
+    Interval den = rho * ratio;
+    if (den.lo > 1e-12) {
+      Interval cp = divPos(Interval{vz, vz} - z, den);
+      cp = {std::clamp(cp.lo, -1.0, 1.0), std::clamp(cp.hi, -1.0, 1.0)};
+      double p0 = std::acos(cp.hi), p1 = std::acos(cp.lo);
+      // Near the plane of incidence rho is small and the cosine loose; sin(phi_d) = v.x w.y /
+      // (rho sin(theta_d)) in [0, sMax] keeps phi_d within asin(sMax) of 0 or pi.
+      Interval sd = sqrtI({(1 - d.hi) / 2, (1 - d.lo) / 2});
+      if (sd.lo > 1e-12) {
+        double sMax = vx * y.hi / (rho.lo * sd.lo);
+        if (sMax < 1) {
+          double a = std::asin(sMax);
+          if (p0 >= M_PI / 2) p0 = std::max(p0, M_PI - a);
+          else if (p1 <= M_PI / 2) p1 = std::min(p1, a);
         }
-      up = {lo * 180 / M_PI - pad, hi * 180 / M_PI + pad};
-      if (up.lo < 0) up = {up.lo + 180, up.hi + 180};
-      if (up.lo < 0) up = {up.lo + 180, up.hi + 180};
-      if (up.hi - up.lo >= 179) up = {0, 180};
+      }
+      up = {p0 * 180 / M_PI - pad, p1 * 180 / M_PI + pad};
     }
   }
   return merlBoxMax(t, uh, ud, up);
