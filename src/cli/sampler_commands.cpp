@@ -267,7 +267,7 @@ int benchPrecompute(const BenchArgs& a) {
   }
   for (const std::string& f : a.files) {
     const ModelSpec& m = *findModel("merl");
-    rows.emplace_back("merl:" + std::filesystem::path(f).filename().string(), &m, measuredParams(m, f, {}));
+    rows.emplace_back("merl-" + std::filesystem::path(f).filename().string(), &m, measuredParams(m, f, {}));
   }
   for (const auto& [name, model, p] : rows) {
     const ModelSpec& m = *model;
