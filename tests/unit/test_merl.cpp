@@ -27,12 +27,15 @@ std::string writeBytes(const std::string& name, const std::vector<unsigned char>
 }
 // The message loadMerl throws for `bytes`, or "" if it loads.
 std::string loadError(const std::string& name, const std::vector<unsigned char>& bytes) {
+  const std::string path = writeBytes(name, bytes);
+  std::string message;
   try {
-    loadMerl(writeBytes(name, bytes), "bad/" + name);
+    loadMerl(path, "bad/" + name);
   } catch (const Error& e) {
-    return e.what();
+    message = e.what();
   }
-  return "";
+  std::filesystem::remove(path);
+  return message;
 }
 
 }  // namespace
@@ -157,7 +160,7 @@ TEST(Merl, AlbedoOfTabulatedModels) {
       }
       double l1 = hemisphereIntegral(
           [&](vec3 w) { return std::abs(double(luminance(brdfEval(MODEL_MERL, p, v, w))) - luminance(brdfEval(model, a, v, w))); },
-          t, 0.0, 1e-4);
+          t, 0.0, 1e-3);
       std::printf("merl(%s) theta %4.1f: albedo %.6f, model %.6f, difference %.2e, tabulation error (L1) %.2e (%.2f%%)\n",
                   s.name.c_str(), t, am, aa, am - aa, l1, 100 * l1 / aa);
       EXPECT_LE(std::abs(am - aa), l1 * (1 + 1e-3) + 1e-6) << t;
