@@ -41,8 +41,8 @@ scene measured '{"model": "merl", "file": "white.binary"}'
 # rejection decision changes one sample of one pixel, so the means agree to far better than 1e-3.
 args=(--spp 4 --width 48 --height 48 --seed 7 -q)
 "$nusselt" render "$work/scene/analytic.glb" -o "$work/analytic.exr" "${args[@]}" 2>"$work/stderr" || fail "analytic render: $(cat "$work/stderr")"
+mean() { "$nusselt" info "$1" 2>&1 | sed -n 's/.*mean[^0-9-]*\([0-9.e+-]*\).*/\1/p' | head -1; }
 if "$nusselt" render "$work/scene/measured.glb" -o "$work/measured.exr" "${args[@]}" 2>"$work/stderr"; then
-  mean() { "$nusselt" info "$1" 2>&1 | sed -n 's/.*mean[^0-9-]*\([0-9.e+-]*\).*/\1/p' | head -1; }
   a=$(mean "$work/analytic.exr"); m=$(mean "$work/measured.exr")
   if python3 -c "import sys; a, m = float('$a'), float('$m'); sys.exit(0 if a > 0 and abs(a - m) <= 1e-3 * a else 1)"; then
     echo "ok   render: mean $m (analytic lambert $a)"
@@ -51,6 +51,22 @@ if "$nusselt" render "$work/scene/measured.glb" -o "$work/measured.exr" "${args[
   fi
 else
   fail "measured render: $(cat "$work/stderr")"
+fi
+
+# The same as one component of a combined material (the components' albedo tables on the CPU, the
+# table in the combined shade stage on the GPU).
+scene analytic2 '{"components": [{"model": "lambert", "weight": 0.5, "params": {"rho": 0.5}}, {"model": "phong", "weight": 0.5}]}'
+scene measured2 '{"components": [{"model": "merl", "weight": 0.5, "file": "white.binary"}, {"model": "phong", "weight": 0.5}]}'
+if "$nusselt" render "$work/scene/analytic2.glb" -o "$work/analytic2.exr" "${args[@]}" 2>"$work/stderr" &&
+   "$nusselt" render "$work/scene/measured2.glb" -o "$work/measured2.exr" "${args[@]}" 2>"$work/stderr"; then
+  a=$(mean "$work/analytic2.exr"); m=$(mean "$work/measured2.exr")
+  if python3 -c "import sys; a, m = float('$a'), float('$m'); sys.exit(0 if a > 0 and abs(a - m) <= 1e-3 * a else 1)"; then
+    echo "ok   combined render: mean $m (analytic $a)"
+  else
+    fail "combined render: mean $m, analytic $a"
+  fi
+else
+  fail "combined render: $(cat "$work/stderr")"
 fi
 
 # expect_error NAME MATERIAL_JSON EXPECTED_TEXT...: the scene with that material fails cleanly.
