@@ -244,6 +244,8 @@ struct BenchArgs {
 // The time to build every model's trees (cache off), their size and shape, beside the paper's
 // start-up times; with --audit N, every leaf's envelope checked against f on an N x N lattice.
 int benchPrecompute(const BenchArgs& a) {
+  if (std::find(a.models.begin(), a.models.end(), "merl") != a.models.end() && a.files.empty())
+    throw Error("--model merl needs --file, a MERL binary file (docs/measured.md)");
   static const std::map<std::string, double> paper = {
       {"ashikhmin_shirley", 51.4}, {"beard_maxwell", 15.5}, {"blinn", 8.7}, {"coupled", 22.6},
       {"htsg", 102.7}, {"lafortune", 6.6}, {"lewis", 6.9}, {"minnaert", 7.3}, {"oren_nayar", 10.5},
