@@ -212,7 +212,6 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     vk::uploadBuffer(m_ctx, m_measured, merlTable(p).rgb.data(), MERL_TABLE_FLOATS * sizeof(float),
                      k * MERL_TABLE_FLOATS * sizeof(float));
   }
-  m_measuredTables = static_cast<std::uint32_t>(measuredSlots.size());
 }
 
 MaterialTable::~MaterialTable() {
