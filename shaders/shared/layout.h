@@ -266,8 +266,9 @@ struct Globals {
   BUFREF(TabSets) tabSets;     // tabulated sampler: one set of tables per material (GpuMaterial.info.z)
   BUFREF(TabTables) tabTables;
   BUFREF(Floats) tabData;      // the CDFs of every table
+  BUFREF(Floats) measured;     // measured BRDF tables (merl: MERL_TABLE_FLOATS each, brdf/merl.h)
 };
-STATIC_ASSERT_SIZE(Globals, 64 + 6 * 16 + 29 * 8);
+STATIC_ASSERT_SIZE(Globals, 64 + 6 * 16 + 30 * 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 

@@ -441,6 +441,7 @@ int benchPipelinesCommand(int device) {
 
 struct AlbedoArgs {
   std::string model;
+  std::string file;  // measured models
   std::vector<std::string> params;
   std::string set;
   double theta = 0;
@@ -451,11 +452,7 @@ struct AlbedoArgs {
 // incident direction at polar angle theta (azimuth phi), by adaptive quadrature.
 int albedoCommand(const AlbedoArgs& a) {
   const ModelSpec* spec = findModel(a.model);
-  if (!spec) {
-    std::string known;
-    for (const ModelSpec& m : allModels()) known += (known.empty() ? "" : ", ") + m.name;
-    throw Error("--model " + a.model + ": unknown model (known: " + known + ")");
-  }
+  if (!spec) throw Error("--model " + a.model + ": unknown model (known: " + knownModelNames() + ")");
   if (!(a.theta >= 0 && a.theta <= 90)) throw Error("--theta must be in [0, 90] degrees");
   NamedParams values;
   if (a.set == "typical") values = typicalParams(*spec);
@@ -465,7 +462,9 @@ int albedoCommand(const AlbedoArgs& a) {
     values.erase(std::remove_if(values.begin(), values.end(), [&](auto& e) { return e.first == kv.first; }), values.end());
     values.push_back(kv);
   }
-  BrdfParams params = packParams(*spec, values, "--model " + spec->name);
+  BrdfParams params = spec->measured ? measuredParams(*spec, a.file, a.params)
+                                     : packParams(*spec, values, "--model " + spec->name);
+  if (!spec->measured && !a.file.empty()) throw Error("--file: only measured models (merl) read a file");
   double rgb[3];
   directionalAlbedoRgb(spec->id, params, a.theta, a.phi, rgb);
   double lum = directionalAlbedo(spec->id, params, a.theta, a.phi);
@@ -568,6 +567,7 @@ int runCli(int argc, char** argv) {
                                                   "luminance over the hemisphere), to at least 6 significant digits");
   albedo->add_option("--model", aa.model, "Model name (docs/models.md)")->required();
   albedo->add_option("--param", aa.params, "name=value or name=r,g,b (repeatable); others take their defaults");
+  albedo->add_option("--file", aa.file, "Measured models (merl): the MERL binary file (docs/measured.md)");
   albedo->add_option("--set", aa.set, "Start from the catalogue's typical or hard parameter set")
       ->check(CLI::IsMember({"typical", "hard"}));
   albedo->add_option("--theta", aa.theta, "Polar angle of the incident direction, degrees")->required();
