@@ -20,6 +20,36 @@ tmp=$(mktemp)
     "$nusselt" $cmd 2>&1
     echo '```'
   done
+  # Measured materials (docs/measured.md): MERL files tabulating analytic models, written by
+  # make_merl into a temporary folder (the commands run there, so the output names the files only).
+  merl=$(mktemp -d)
+  make_merl=$(dirname "$nusselt")/make_merl
+  "$make_merl" --model lambert --param rho=0.5 -o "$merl/lambert05.binary" >/dev/null
+  "$make_merl" --model torrance_sparrow -o "$merl/torrance_sparrow.binary" >/dev/null
+  "$make_merl" --model ward -o "$merl/ward.binary" >/dev/null
+  files="--file lambert05.binary --file torrance_sparrow.binary --file ward.binary"
+  echo
+  echo "## Measured materials: nusselt bench precompute --model merl $files --audit 16"
+  echo
+  echo "The files are written by \`make_merl\` from lambert (rho 0.5), torrance_sparrow and ward (typical sets)."
+  echo
+  echo '```'
+  (cd "$merl" && "$nusselt" bench precompute --model merl $files --audit 16 2>&1)
+  echo '```'
+  echo
+  echo "## Measured materials: albedo of the tabulation against the model (nusselt albedo)"
+  echo
+  echo '```'
+  echo "model             theta   tabulated   analytic   difference"
+  for m in torrance_sparrow ward; do
+    for t in 0 30 60 85; do
+      a=$("$nusselt" albedo --model merl --file "$merl/$m.binary" --theta $t 2>/dev/null)
+      b=$("$nusselt" albedo --model $m --theta $t 2>/dev/null)
+      awk -v m="$m" -v t="$t" -v a="$a" -v b="$b" 'BEGIN { printf "%-17s %5s %11.6f %10.6f %12.3e\n", m, t, a, b, a - b }'
+    done
+  done
+  echo '```'
+  rm -rf "$merl"
 } >"$tmp"
 mv "$tmp" "$out"
 echo "wrote $out"

@@ -48,6 +48,11 @@ SHARED_BEGIN
 #endif
 NUSSELT_STATS(NUSSELT_STAT_INDEX)
 #define STAT_COUNT 16u  // room in the stats buffer
+// After the counters: extension rays traced per bounce (the ray queue's size when its intersect
+// stage starts), for `bench render`; bounces past the last slot count in the last one.
+#define STAT_PER_BOUNCE STAT_COUNT
+#define STAT_BOUNCE_SLOTS 64u
+#define STAT_BUFFER_UINTS (STAT_COUNT + STAT_BOUNCE_SLOTS)
 
 // ---- Light types ----------------------------------------------------------------------------------
 #define LIGHT_TRIANGLE 0u
@@ -208,9 +213,10 @@ struct Globals {
   // The image and this pass (four uints at a time: the vec4s below stay 16-byte aligned).
   uint width;            // image size in pixels
   uint height;
-  uint chunkFirstPixel;  // first pixel of the chunk of paths this dispatch batch traces
-  uint chunkPixels;      // paths in this chunk
-  uint sampleIndex;      // sample index of this pass
+  uint chunkFirst;       // first path of this chunk: path p of a pass traces sample p % passSamples of
+                         // pixel p / passSamples, so a pixel's samples are neighbours
+  uint chunkPaths;       // paths in this chunk
+  uint sampleIndex;      // sample index of the pass's first sample
   uint seed;
   uint maxDepth;
   uint pathCapacity;     // paths per chunk: the stride of the queues' item arrays
@@ -222,7 +228,7 @@ struct Globals {
   uint rngMode;          // RNG_PCG or RNG_QMC
   uint componentChoice;  // COMPONENTS_*
   uint roulette;         // ROULETTE_*
-  uint reserved0;
+  uint passSamples;      // samples per pixel in this pass (sample indices sampleIndex + 0 .. passSamples - 1)
   vec4 camPosition; // xyz, w = 1 for orthographic
   vec4 camRight;    // unit right * (tan(yfov/2) * aspect), or * xmag for orthographic
   vec4 camUp;       // unit up * tan(yfov/2), or * ymag for orthographic
@@ -243,7 +249,7 @@ struct Globals {
   BUFREF(Vec4s) pathThroughput;// per path: throughput (rgb), w = etaScale (the product of (n_t / n_i)^2 over
                                // refractions, which undoes their radiance scaling for the roulette)
   BUFREF(Vec4s) pathRadiance;  // per path: radiance gathered so far (rgb)
-  BUFREF(UVec4s) pathInfo;     // per path: (pixel, flags, 0, 0)
+  BUFREF(UVec4s) pathInfo;     // per path: (pixel, sample index, 0, 0)
   BUFREF(Vec4s) pathHit;       // per path: (t, b1, b2, triangle bits)
   BUFREF(Vec4s) shadowOrigin;  // per path: shadow ray origin, w = tmax
   BUFREF(Vec4s) shadowDirection;
@@ -260,12 +266,13 @@ struct Globals {
   BUFREF(TabSets) tabSets;     // tabulated sampler: one set of tables per material (GpuMaterial.info.z)
   BUFREF(TabTables) tabTables;
   BUFREF(Floats) tabData;      // the CDFs of every table
+  BUFREF(Floats) measured;     // measured BRDF tables (merl: MERL_TABLE_FLOATS each, brdf/merl.h)
   // The top-level acceleration structure's device address, low and high 32 bits, for ray queries
   // (shaders/shared/trace.glsl with NUSSELT_RAY_QUERY); 0 when the GLSL BVH traces.
   uint tlasLow;
   uint tlasHigh;
 };
-STATIC_ASSERT_SIZE(Globals, 64 + 6 * 16 + 29 * 8 + 8);
+STATIC_ASSERT_SIZE(Globals, 64 + 6 * 16 + 30 * 8 + 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 
@@ -286,7 +293,7 @@ struct SubmitConstants {
   uint argsCount;
   uint zeroFirst;   // first of a range of queues to empty
   uint zeroCount;
-  uint reserved0;
+  uint bounce;      // the bounce whose ray queue argsQueue is (per-bounce ray counts)
   uint reserved1;
   uint reserved2;
 };

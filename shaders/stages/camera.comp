@@ -1,19 +1,22 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// camera: one primary ray per pixel of this chunk; initialises the path state and fills ray
-// queue 0 with every path (path i <-> pixel chunkStart + i).
+// camera: one primary ray per path of this chunk; initialises the path state and fills ray
+// queue 0 with every path. Path i of the chunk traces sample k = (chunkFirst + i) % passSamples
+// (sample index sampleIndex + k) of pixel (chunkFirst + i) / passSamples.
 #include "shared/stage_common.glsl"
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
-  if (i >= g.chunkPixels) return;
-  uint pixel = g.chunkFirstPixel + i;
+  if (i >= g.chunkPaths) return;
+  uint global = g.chunkFirst + i;
+  uint pixel = global / g.passSamples;
+  uint sampleIndex = g.sampleIndex + global % g.passSamples;
   uint width = g.width;
   uint px = pixel % width;
   uint py = pixel / width;
 
   // Pixel jitter: dimensions 0 and 1 (box filter over the pixel).
-  vec2 u = sample2(g.rngMode, pixel, g.sampleIndex, 0u, g.seed);
+  vec2 u = sample2(g.rngMode, pixel, sampleIndex, 0u, g.seed);
   float sx = ((float(px) + u.x) / float(width)) * 2.0f - 1.0f;
   float sy = 1.0f - ((float(py) + u.y) / float(g.height)) * 2.0f;
 
@@ -31,7 +34,7 @@ void main() {
   g.pathDirection.v[i] = vec4(dir, 0.0f);  // w = 0: no BSDF pdf yet (camera ray)
   g.pathThroughput.v[i] = vec4(1.0f, 1.0f, 1.0f, 1.0f);  // w: etaScale
   g.pathRadiance.v[i] = vec4(0.0f);
-  g.pathInfo.v[i] = uvec4(pixel, 0u, 0u, 0u);
+  g.pathInfo.v[i] = uvec4(pixel, sampleIndex, 0u, 0u);
   g.queues.v[QUEUE_HEADER_UINTS + QUEUE_RAY0 * g.pathCapacity + i] = i;
-  if (i == 0u) g.queues.v[QUEUE_RAY0] = g.chunkPixels;
+  if (i == 0u) g.queues.v[QUEUE_RAY0] = g.chunkPaths;
 }

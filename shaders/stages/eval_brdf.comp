@@ -5,10 +5,7 @@
 // eval_brdf: evaluates one model (specialization constant MODEL) at a list of direction pairs:
 // the GPU side of the CPU/GPU parity test of the shared BRDF definitions.
 #define NUSSELT_STANDALONE_KERNEL
-#include "shared/brdf/dispatch.h"
-
-layout(local_size_x = WORKGROUP_SIZE) in;
-layout(constant_id = 0) const uint MODEL = 0u;
+#include "shared/layout.h"
 
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer PairBuffer { vec4 v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer ParamBuffer { BrdfParams p; };
@@ -18,7 +15,13 @@ layout(push_constant, std430) uniform Push {
   ParamBuffer params;
   ResultBuffer result; // f(wi, wo), rgb
   uint count;
+  Floats measured;     // measured tables (merl), or 0
 } pcEval;
+#define MERL_TABLE_FETCH(slot, i) (pcEval.measured.v[(slot) * MERL_TABLE_FLOATS + (i)])
+#include "shared/brdf/dispatch.h"
+
+layout(local_size_x = WORKGROUP_SIZE) in;
+layout(constant_id = 0) const uint MODEL = 0u;
 
 void main() {
   uint i = gl_GlobalInvocationID.x;

@@ -42,8 +42,9 @@ void main() {
   if (idx >= queueCount(queue)) return;
   uint path = queueItem(queue, idx);
   uint bounce = pc.bounce;
-  uint pixel = g.pathInfo.v[path].x;
-  uint sampleIndex = g.sampleIndex;
+  uvec4 info = g.pathInfo.v[path];
+  uint pixel = info.x;
+  uint sampleIndex = info.y;
   uint seed = g.seed;
   uint lighting = g.lighting;
   uint rngMode = g.rngMode;

@@ -9,7 +9,10 @@ STAGE_PUSH(SubmitConstants);
 void writeArgs(uint queue) {
   uint count = g.queues.v[queue];
   g.dispatchArgs.v[queue] = uvec4((count + WORKGROUP_SIZE - 1u) / WORKGROUP_SIZE, 1u, 1u, 0u);
-  if (queue == QUEUE_RAY0 || queue == QUEUE_RAY1) atomicAdd(g.stats.v[STAT_RAYS], count);
+  if (queue == QUEUE_RAY0 || queue == QUEUE_RAY1) {
+    atomicAdd(g.stats.v[STAT_RAYS], count);
+    atomicAdd(g.stats.v[STAT_PER_BOUNCE + min(pc.bounce, STAT_BOUNCE_SLOTS - 1u)], count);
+  }
   if (queue == QUEUE_SHADOW) atomicAdd(g.stats.v[STAT_SHADOW_RAYS], count);
 }
 

@@ -292,17 +292,40 @@ const std::vector<ModelSpec>& allModels() {
   return models;
 }
 
+const std::vector<ModelSpec>& measuredModels() {
+  static const std::vector<ModelSpec> models = [] {
+    ModelSpec m;
+    m.name = "merl";
+    m.id = MODEL_MERL;
+    m.measured = true;
+    m.summary = "measured isotropic BRDF in the MERL 100 binary layout, trilinearly interpolated (docs/measured.md)";
+    return std::vector<ModelSpec>{m};
+  }();
+  return models;
+}
+
+std::string knownModelNames() {
+  std::string known;
+  for (const ModelSpec& s : allModels()) known += (known.empty() ? "" : ", ") + s.name;
+  for (const ModelSpec& s : measuredModels()) known += ", " + s.name;
+  return known;
+}
+
 const NamedParams& typicalParams(const ModelSpec& model) { return model.typical; }
 const NamedParams& hardParams(const ModelSpec& model) { return model.hard; }
 
 const ModelSpec* findModel(std::string_view name) {
   for (const ModelSpec& m : allModels())
     if (m.name == name) return &m;
+  for (const ModelSpec& m : measuredModels())
+    if (m.name == name) return &m;
   return nullptr;
 }
 
 const ModelSpec& modelById(std::uint32_t id) {
   for (const ModelSpec& m : allModels())
+    if (m.id == id) return m;
+  for (const ModelSpec& m : measuredModels())
     if (m.id == id) return m;
   throw Error("internal: unknown model id " + std::to_string(id));
 }
@@ -321,6 +344,9 @@ std::string describeRange(const ParamSpec& spec) {
 }
 
 BrdfParams packParams(const ModelSpec& model, const NamedParams& values, const std::string& context) {
+  if (model.measured)
+    throw Error(context + ": model \"" + model.name + "\" is measured: it reads a table from a file (\"file\" in a "
+                "scene, --file on the command line), it has no parameters");
   BrdfParams p{};
   auto set = [&p](std::uint32_t i, float v) { p.v[i / 4][i % 4] = v; };
   for (const ParamSpec& spec : model.params) {

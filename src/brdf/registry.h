@@ -59,6 +59,7 @@ struct ModelSpec {
   std::string name;
   std::uint32_t id = 0;  // MODEL_* in shaders/shared/brdf/dispatch.h
   bool delta = false;    // mirror, dielectric: never evaluated or light-sampled
+  bool measured = false; // merl: a table read from a file (loadMerl, src/brdf/merl.h), no parameters
   std::vector<ParamSpec> params;
   std::string summary;
   // The catalogue's parameter sets (docs/brdf-models.md): typical (= the defaults) and hard
@@ -69,12 +70,19 @@ struct ModelSpec {
 };
 
 
+// The analytic catalogue (the 20 models of docs/models.md).
 const std::vector<ModelSpec>& allModels();
+// Measured models (merl): not in allModels(), whose loops need parameter sets; found by findModel
+// and modelById like the others.
+const std::vector<ModelSpec>& measuredModels();
+// "lambert, phong_specular, ..., merl": the names findModel knows (messages).
+std::string knownModelNames();
 // nullptr when unknown.
 const ModelSpec* findModel(std::string_view name);
 const ModelSpec& modelById(std::uint32_t id);
 
-// Packs named values into a BrdfParams block, defaults for the others. Throws nusselt::Error
+// Packs named values into a BrdfParams block, defaults for the others (measured models: throws,
+// their block comes from loadMerl). Throws nusselt::Error
 // naming `context` (e.g. "scene.gltf: materials[2] \"Floor\""), the parameter and its allowed
 // range when a value is unknown, malformed, non-finite or out of range.
 BrdfParams packParams(const ModelSpec& model, const NamedParams& values, const std::string& context);

@@ -43,6 +43,7 @@
 #include <vector>
 
 #include "brdf/albedo.h"
+#include "brdf/merl.h"
 #include "brdf/registry.h"
 #include "cli/cli_common.h"
 #include "cli/commands.h"
@@ -71,6 +72,7 @@ struct ErrorArgs {
   std::vector<std::string> models;
   std::vector<std::string> presets;
   std::vector<double> angles;
+  std::vector<std::string> files;  // measured materials (merl), experiment 1
   bool noPoint = false, noScenes = false;
   std::uint32_t width = 0, spp = 0, refSpp = 0;
   std::string commandLine;
@@ -151,6 +153,7 @@ double timeToError(const Curve& c, double e, bool& extrapolated) {
 struct PointConfig {
   std::vector<std::string> models;
   std::vector<std::string> presets;
+  std::vector<std::string> files;  // measured materials: model "merl-<file name>", preset "measured"
   std::vector<double> angles;
   int maxLog2 = 20;
   int reps = 16;
@@ -161,11 +164,30 @@ std::vector<Curve> runPoint(vk::Context& ctx, const PointConfig& pc, Progress& p
   const std::uint64_t n = std::uint64_t(1) << pc.maxLog2;
   // Repetitions per GPU call: at most 2^22 samples (128 MiB of read-back) per call.
   const std::uint64_t repsPerCall = std::max<std::uint64_t>(1, (std::uint64_t(1) << 22) / n);
+  // The materials: every model x preset, then each measured file.
+  struct Material {
+    std::string name;
+    const ModelSpec* m;
+    std::string preset;
+    BrdfParams p;
+  };
+  std::vector<Material> materials;
   for (const std::string& name : pc.models) {
     const ModelSpec* m = findModel(name);
-    if (!m || m->delta) throw Error("bench error --model " + name + ": unknown or delta model");
-    for (const std::string& preset : pc.presets) {
-      BrdfParams p = packParams(*m, preset == "hard" ? hardParams(*m) : typicalParams(*m), m->name);
+    if (!m || m->delta || m->measured)
+      throw Error("bench error --model " + name + ": unknown, delta or measured model (measured: --file)");
+    for (const std::string& preset : pc.presets)
+      materials.push_back({m->name, m, preset, packParams(*m, preset == "hard" ? hardParams(*m) : typicalParams(*m), m->name)});
+  }
+  for (const std::string& f : pc.files) {
+    const ModelSpec* m = findModel("merl");
+    materials.push_back({"merl-" + std::filesystem::path(f).filename().string(), m, "measured", measuredParams(*m, f, {})});
+  }
+  for (const Material& mat : materials) {
+    const ModelSpec* m = mat.m;
+    {
+      const std::string& preset = mat.preset;
+      const BrdfParams& p = mat.p;
       std::vector<std::uint32_t> qSet, tSet;
       quadtree::SamplerTables qt = quadtree::buildSamplerTables({{m->id, p}}, quadtree::QuadtreeSettings{}, qSet);
       sampling::TabulatedSettings ts;
@@ -228,7 +250,7 @@ std::vector<Curve> runPoint(vk::Context& ctx, const PointConfig& pc, Progress& p
           const double total = double(pc.reps) * double(n);
           for (int q = 0; q < 2; ++q) {
             Curve& cv = c[q];
-            cv.model = m->name;
+            cv.model = mat.name;
             cv.preset = preset;
             cv.theta = th;
             cv.strategy = s;
@@ -381,9 +403,9 @@ RenderResult renderTimed(vk::Context& ctx, const Scene& scene, RenderSettings s)
   r.renderPass();  // warm-up: lavapipe compiles each pipeline at its first dispatch
   r.reset();
   auto t0 = std::chrono::steady_clock::now();
-  for (std::uint32_t i = 0; i < s.spp; ++i) {
+  while (r.samplesDone() < s.spp) {
     if (g_stopSignal) throw Error("interrupted");
-    r.renderPass();
+    r.renderPass(s.spp - r.samplesDone());
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.image = r.image(true);
@@ -475,6 +497,10 @@ std::string reportMarkdown(const ErrorArgs& a, const PointConfig& pc, const std:
     for (std::size_t i = 0; i < pc.models.size(); ++i) o << (i ? ", " : "") << pc.models[i];
     o << "; presets ";
     for (std::size_t i = 0; i < pc.presets.size(); ++i) o << (i ? ", " : "") << pc.presets[i];
+    if (!pc.files.empty()) {
+      o << "; measured materials (merl, preset `measured`; `analytic` is cosine there)";
+      for (std::size_t i = 0; i < pc.files.size(); ++i) o << (i ? ", " : " ") << "`" << pc.files[i] << "`";
+    }
     o << "; incident angles ";
     for (std::size_t i = 0; i < pc.angles.size(); ++i) o << (i ? ", " : "") << pc.angles[i];
     o << " deg; sample counts 2^0 .. 2^" << pc.maxLog2 << "; relative error = RMS over " << pc.reps
@@ -655,6 +681,7 @@ int benchError(const ErrorArgs& a) {
   if (!a.models.empty()) pc.models = a.models;
   if (!a.presets.empty()) pc.presets = a.presets;
   if (!a.angles.empty()) pc.angles = a.angles;
+  pc.files = a.files;
   if (a.maxLog2 >= 0) pc.maxLog2 = a.maxLog2;
   if (a.reps > 0) pc.reps = a.reps;
   for (double th : pc.angles)
@@ -678,7 +705,8 @@ int benchError(const ErrorArgs& a) {
 
   std::vector<SceneCase> scenes;
   if (!a.noScenes) scenes = makeScenes(a.quick);
-  std::uint64_t steps = (a.noPoint ? 0 : pc.models.size() * pc.presets.size() * pc.angles.size() * kStrategies.size());
+  const std::size_t pointMaterials = pc.models.size() * pc.presets.size() + pc.files.size();
+  std::uint64_t steps = (a.noPoint ? 0 : pointMaterials * pc.angles.size() * kStrategies.size());
   for (const SceneCase& sc : scenes) {
     steps += 1 + kStrategies.size();
     if (sc.name == "cornell") steps += 1;           // qmc
@@ -689,7 +717,7 @@ int benchError(const ErrorArgs& a) {
 
   // ---- Experiment 1 ----
   std::vector<Curve> curves;
-  const double zPointDen = 2.0 * double(pc.models.size() * pc.presets.size() * pc.angles.size() * kStrategies.size());
+  const double zPointDen = 2.0 * double(pointMaterials * pc.angles.size() * kStrategies.size());
   const double zPoint = zCritical(1e-3 / zPointDen);
   if (!a.noPoint) {
     curves = runPoint(ctx, pc, progress, step);
@@ -711,10 +739,14 @@ int benchError(const ErrorArgs& a) {
           << c.extrapolated[1] << "," << c.failed << "," << c.trialFailures << "," << c.tabBytes << ","
           << c.quadBytesPerTree << "\n";
     }
-    // One plot per model and preset: rows = integrands, columns = angles.
+    // One plot per model and preset (and per measured file): rows = integrands, columns = angles.
     const int pw = 260, ph = 180, gap = 10;
+    std::vector<std::pair<std::string, std::string>> plots;
     for (const std::string& model : pc.models)
-      for (const std::string& preset : pc.presets) {
+      for (const std::string& preset : pc.presets) plots.push_back({model, preset});
+    for (const std::string& f : pc.files) plots.push_back({"merl-" + std::filesystem::path(f).filename().string(), "measured"});
+    for (const auto& [model, preset] : plots) {
+      {
         Canvas cv(int(pc.angles.size()) * (pw + gap) + gap, 2 * (ph + gap) + gap);
         for (int q = 0; q < 2; ++q)
           for (std::size_t ai = 0; ai < pc.angles.size(); ++ai) {
@@ -725,6 +757,7 @@ int benchError(const ErrorArgs& a) {
           }
         writePng(a.out + "/point-" + model + "-" + preset + ".png", cv.img);
       }
+    }
   }
 
   // ---- Experiment 2 ----
@@ -858,6 +891,8 @@ void registerBenchError(CLI::App& bench, CommandRunner& run) {
       ->check(CLI::Range(0, 24));
   e->add_option("--reps", ea->reps, "Experiment 1: independent repetitions (default 16, quick 8)")->check(CLI::Range(2, 1024));
   e->add_option("--model", ea->models, "Experiment 1: only these models (repeatable)");
+  e->add_option("--file", ea->files, "Experiment 1: also a measured material (merl) from this MERL binary file (repeatable)")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   e->add_option("--preset", ea->presets, "Experiment 1: typical and/or hard (repeatable)")
       ->check(CLI::IsMember({"typical", "hard"}));
   e->add_option("--angle", ea->angles, "Experiment 1: incident angles in degrees (repeatable)");

@@ -1,6 +1,10 @@
 #include "cli/cli_common.h"
 
 #include <cstdio>
+
+#include "brdf/merl.h"
+
+#include <cstdio>
 #include <unistd.h>
 
 #include <csignal>
@@ -45,6 +49,17 @@ void printSceneWarnings(const Scene& scene, bool quiet) {
                  "warning: %s: dropped %llu degenerate triangles (zero area, non-finite vertices or coordinates "
                  "beyond 1e15)\n",
                  scene.sourcePath.c_str(), static_cast<unsigned long long>(scene.droppedTriangles));
+}
+
+BrdfParams measuredParams(const ModelSpec& model, const std::string& file, const std::vector<std::string>& params) {
+  if (file.empty()) throw Error("--model " + model.name + " needs --file, a MERL binary file (docs/measured.md)");
+  if (!params.empty()) throw Error("--param: model " + model.name + " has no parameters (it reads --file)");
+  BrdfParams p = loadMerl(file, "--file " + file);
+  const MerlTable& t = merlTable(p);
+  if (t.unmeasured)
+    std::fprintf(stderr, "%s: %u of %u table nodes not measured (negative), filled from the nearest measured node\n",
+                 file.c_str(), t.unmeasured, unsigned(MERL_NODES));
+  return p;
 }
 
 }  // namespace nusselt

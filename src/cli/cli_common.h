@@ -3,6 +3,7 @@
 #pragma once
 #include <atomic>
 #include <string>
+#include <vector>
 
 #include "scene/scene.h"
 #include "util/stop_signal.h"
@@ -18,6 +19,11 @@ void checkOutputPath(const std::string& path, const std::string& option);
 
 // The scene at `path`, or the built-in Cornell box when `path` is empty.
 Scene loadSceneOrDefault(const std::string& path, const std::string& camera);
+
+// The parameter block of a measured model (merl) from --file: throws nusselt::Error when the file
+// is missing or bad (naming it), or when --param options were given (a table has no parameters).
+// Prints the count of unmeasured nodes on stderr.
+BrdfParams measuredParams(const ModelSpec& model, const std::string& file, const std::vector<std::string>& params);
 
 // The loader's warnings on stderr (unless quiet), with the count of dropped triangles.
 void printSceneWarnings(const Scene& scene, bool quiet);

@@ -2,6 +2,7 @@
 #include "cli/commands.h"
 
 #include <CLI/CLI.hpp>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <thread>
 
 #include "brdf/albedo.h"
 #include "cli/cli_common.h"
@@ -40,6 +42,7 @@ struct RenderArgs {
   std::uint32_t seed = 0;
   std::uint32_t sppOffset = 0;
   std::uint32_t maxDepth = 8;
+  std::uint32_t samplesPerPass = 0;
   int device = -1;
   std::string lighting = "mis";
   std::string rng = "pcg";
@@ -73,6 +76,7 @@ int renderCommand(const RenderArgs& a) {
   s.seed = a.seed;
   s.maxDepth = a.maxDepth;
   s.sampleOffset = a.sppOffset;
+  s.samplesPerPass = a.samplesPerPass;
   parseLighting(a.lighting, s.lighting);
   parseRngMode(a.rng, s.rng);
   parseSampler(a.sampler, s.sampler);
@@ -168,12 +172,12 @@ int renderCommand(const RenderArgs& a) {
                      sum.samplerTrees, sum.samplerBytes / 1048576.0, sum.samplerSeconds, sum.samplerCacheHits,
                      sum.samplerCacheMisses, sum.samplerCacheRejected);
       std::string budget = a.timeBudget > 0 ? ", time budget " + std::to_string(a.timeBudget) + " s" : "";
-      std::fprintf(stderr, "device: %s (%s); %ux%u, %s spp%s%s, max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
+      std::fprintf(stderr, "device: %s (%s); %ux%u, %s spp%s%s (%u per pass), max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
                            "roulette %s, traversal %s\n",
                    ctx.deviceName.c_str(), ctx.driverInfo.c_str(), s.width, s.height,
                    targetSpp == (1u << 30) ? "unlimited" : std::to_string(targetSpp).c_str(),
                    a.resume.empty() ? "" : (" (resuming from " + std::to_string(previous.spp) + ")").c_str(),
-                   budget.c_str(), s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng),
+                   budget.c_str(), renderer.samplesPerPass(), s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng),
                    samplerName(s.sampler), rouletteModeName(s.roulette), traversalName(sum.traversal));
     }
 
@@ -293,54 +297,101 @@ int devicesCommand() {
 
 struct BenchArgs {
   std::vector<std::string> scenes;
-  std::uint32_t spp = 4;
+  std::uint32_t spp = 16;
   std::uint32_t width = 256, height = 256;
+  std::uint32_t maxDepth = 8;
+  std::uint32_t samplesPerPass = 0;
   int device = -1;
   std::vector<std::string> traversals{"auto"};
   std::uint32_t repeats = 1;
 };
 
-// One timed render of bench render.
+double cpuSecondsUsed() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+// The figures of one timed render of bench render (medians over repeats).
 struct BenchRun {
   double setupSeconds = 0;   // the Renderer: BVH or acceleration structures, quadtrees, pipelines
   double warmupSeconds = 0;  // the untimed first pass (lavapipe compiles each pipeline at its first dispatch)
-  double seconds = 0;        // the timed passes
   double samplesPerSecond = 0;
   double mraysPerSecond = 0;
-  std::vector<std::pair<std::string, double>> stageShare;  // GPU time by stage / seconds
+  double cpuCores = 0;
 };
 
-BenchRun benchRenderOnce(vk::Context& ctx, const Scene& scene, const BenchArgs& a, Traversal traversal,
-                         std::size_t& triangles) {
+// One render of `scene` with `traversal`: prints its row, its GPU time by stage and shade
+// pipeline, and the paths alive per bounce.
+BenchRun benchRenderOnce(vk::Context& ctx, const Scene& scene, const std::string& path, const BenchArgs& a,
+                         Traversal traversal) {
   RenderSettings s;
   s.width = a.width;
   s.height = a.height;
   s.spp = a.spp;
+  s.maxDepth = a.maxDepth;
+  s.samplesPerPass = a.samplesPerPass;
   s.timeStages = true;
   s.traversal = traversal;
   BenchRun run;
-  auto t0 = std::chrono::steady_clock::now();
+  const auto tSetup = std::chrono::steady_clock::now();
   Renderer r(ctx, scene, s);
-  auto t1 = std::chrono::steady_clock::now();
-  r.renderPass();  // warm-up
-  auto t2 = std::chrono::steady_clock::now();
-  run.setupSeconds = std::chrono::duration<double>(t1 - t0).count();
-  run.warmupSeconds = std::chrono::duration<double>(t2 - t1).count();
-  triangles = r.summary().triangles;
-  std::vector<std::pair<std::string, double>> warm = r.stageSeconds();
-  RenderStats before = r.stats();
-  for (std::uint32_t i = 0; i < a.spp; ++i) r.renderPass();
-  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t2).count();
-  RenderStats after = r.stats();
-  double rays = double(after.rays - before.rays + after.shadowRays - before.shadowRays);
-  run.samplesPerSecond = double(a.spp) * s.width * s.height / run.seconds;
-  run.mraysPerSecond = rays / run.seconds / 1e6;
+  const auto tWarm = std::chrono::steady_clock::now();
+  r.renderPass(1);  // warm-up: lavapipe compiles each pipeline at its first dispatch
+  run.setupSeconds = std::chrono::duration<double>(tWarm - tSetup).count();
+  run.warmupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tWarm).count();
+  const std::vector<std::pair<std::string, double>> warm = r.stageSeconds();
+  const std::vector<std::uint64_t> warmRays = r.raysPerBounce();
+  const RenderStats before = r.stats();
+  const double cpu0 = cpuSecondsUsed();
+  const auto t0 = std::chrono::steady_clock::now();
+  r.render(1 + a.spp);
+  const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double cpu = cpuSecondsUsed() - cpu0;
+  const RenderStats after = r.stats();
+  const double rays = double(after.rays - before.rays + after.shadowRays - before.shadowRays);
+  const double samples = double(a.spp) * s.width * s.height;
+  run.samplesPerSecond = samples / sec;
+  run.mraysPerSecond = rays / sec / 1e6;
+  run.cpuCores = cpu / sec;
+  char size[32];
+  std::snprintf(size, sizeof size, "%ux%u", s.width, s.height);
+  std::printf("%-34s %9zu %9s %9s %5u %6u %8.3f %11.0f %8.3f %9.2f %8.3f %9.3f\n",
+              path.empty() ? "default (cornell-box)" : std::filesystem::path(path).filename().c_str(),
+              r.summary().triangles, size, traversalName(r.settings().traversal), a.spp, r.samplesPerPass(), sec,
+              run.samplesPerSecond, run.mraysPerSecond, run.cpuCores, run.setupSeconds, run.warmupSeconds);
+  double gpu = 0;
+  std::vector<std::pair<std::string, double>> timed;
   for (auto& [name, t] : r.stageSeconds()) {
-    double earlier = 0;
-    for (auto& [n0, t0w] : warm)
-      if (n0 == name) earlier = t0w;
-    run.stageShare.push_back({name, (t - earlier) / run.seconds});
+    double w = 0;
+    for (auto& [n0, t0s] : warm)
+      if (n0 == name) w = t0s;
+    timed.push_back({name, t - w});
+    gpu += t - w;
   }
+  if (gpu > 0) {
+    std::string stages, shades;
+    for (auto& [name, t] : timed) {
+      char buf[96];
+      const bool shade = name.rfind("shade ", 0) == 0;
+      std::snprintf(buf, sizeof buf, "%s%s %.1f%%", (shade ? shades : stages).empty() ? "" : ", ",
+                    shade ? name.c_str() + 6 : name.c_str(), 100.0 * t / gpu);
+      (shade ? shades : stages) += buf;
+    }
+    std::printf("    GPU time %.3f s by stage: %s\n", gpu, stages.c_str());
+    if (!shades.empty()) std::printf("    shade pipelines (model: share of GPU time): %s\n", shades.c_str());
+  }
+  std::string perBounce;
+  const std::vector<std::uint64_t>& bounces = r.raysPerBounce();
+  for (std::size_t b = 0; b < bounces.size(); ++b) {
+    const std::uint64_t n = bounces[b] - (b < warmRays.size() ? warmRays[b] : 0);
+    if (n == 0) continue;
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "%s%zu:%.3g", perBounce.empty() ? "" : " ", b, double(n) / samples);
+    perBounce += buf;
+  }
+  std::printf("    paths per sample alive at bounce (bounce:fraction): %s\n", perBounce.c_str());
+  std::fflush(stdout);
   return run;
 }
 
@@ -357,6 +408,13 @@ std::string medianRange(const std::vector<BenchRun>& runs, F pick, const char* f
   return buf;
 }
 
+// Throughput of the path tracer: for each scene (and traversal, interleaved within each repeat),
+// samples/s and rays/s over `spp` samples per pixel after a warm-up pass (lavapipe compiles a
+// pipeline at its first dispatch), the CPU time the process used per second of wall time (a CPU
+// device should keep every core busy), GPU time per stage and per shade pipeline (timestamps; a
+// barrier after each shade pipeline in this mode), the extension rays per bounce (the queue
+// sizes the wavefront works through), and the set-up (BVH or acceleration structures, quadtrees,
+// pipelines) and warm-up times. With repeats, the medians and ranges per traversal.
 int benchRenderCommand(const BenchArgs& a) {
   std::vector<std::string> scenes = a.scenes;
   if (scenes.empty()) {
@@ -375,54 +433,27 @@ int benchRenderCommand(const BenchArgs& a) {
   vk::ContextOptions co;
   co.deviceIndex = a.device;
   vk::createContext(ctx, co);
-  std::printf("device: %s (%s), %s\n", ctx.deviceName.c_str(), ctx.driverInfo.c_str(),
-              ctx.rayQuery ? "ray queries" : "no ray queries");
-  std::printf("%u timed spp after one warm-up pass; %u repeat%s, traversals interleaved; setup = BVH or acceleration "
-              "structures, quadtrees, pipelines\n",
-              a.spp, a.repeats, a.repeats == 1 ? "" : "s");
-  std::printf("%-40s %10s %9s %9s %8s %9s %10s %12s %9s\n", "scene", "triangles", "size", "traversal", "setup s",
-              "warm-up s", "seconds", "samples/s", "Mrays/s");
-  char size[32];
-  std::snprintf(size, sizeof size, "%ux%u", a.width, a.height);
+  std::printf("device: %s (%s), %u CPU threads, %s\n", ctx.deviceName.c_str(), ctx.driverInfo.c_str(),
+              std::thread::hardware_concurrency(), ctx.rayQuery ? "ray queries" : "no ray queries");
+  std::printf("%-34s %9s %9s %9s %5s %6s %8s %11s %8s %9s %8s %9s\n", "scene", "triangles", "size", "traversal", "spp",
+              "spp/pass", "seconds", "samples/s", "Mrays/s", "CPU cores", "setup s", "warm-up s");
   for (const std::string& path : scenes) {
     Scene scene = loadSceneOrDefault(path, "");
-    const std::string name = path.empty() ? "default (cornell-box)" : path;
     std::vector<std::vector<BenchRun>> runs(traversals.size());
-    std::vector<Traversal> resolved(traversals.size());
-    std::size_t triangles = 0;
     for (std::uint32_t rep = 0; rep < a.repeats; ++rep)
+      for (std::size_t k = 0; k < traversals.size(); ++k)
+        runs[k].push_back(benchRenderOnce(ctx, scene, path, a, traversals[k]));
+    if (a.repeats > 1)
       for (std::size_t k = 0; k < traversals.size(); ++k) {
-        Traversal t = resolveTraversal(ctx, traversals[k]);
-        resolved[k] = t;
-        BenchRun run = benchRenderOnce(ctx, scene, a, t, triangles);
-        std::printf("%-40s %10zu %9s %9s %8.3f %9.3f %10.3f %12.0f %9.3f\n", name.c_str(), triangles, size,
-                    traversalName(t), run.setupSeconds, run.warmupSeconds, run.seconds, run.samplesPerSecond,
-                    run.mraysPerSecond);
-        std::fflush(stdout);
-        runs[k].push_back(std::move(run));
-      }
-    for (std::size_t k = 0; k < traversals.size(); ++k) {
-      const std::vector<BenchRun>& rs = runs[k];
-      if (a.repeats > 1)
-        std::printf("  %s, median [min-max] of %u: setup %s s, warm-up %s s, %s samples/s, %s Mrays/s\n",
-                    traversalName(resolved[k]), a.repeats, medianRange(rs, [](auto& r) { return r.setupSeconds; }, "%.3f").c_str(),
-                    medianRange(rs, [](auto& r) { return r.warmupSeconds; }, "%.3f").c_str(),
+        const std::vector<BenchRun>& rs = runs[k];
+        std::printf("  %s, median [min-max] of %u: %s samples/s, %s Mrays/s, %s CPU cores, setup %s s, warm-up %s s\n",
+                    traversalName(resolveTraversal(ctx, traversals[k])), a.repeats,
                     medianRange(rs, [](auto& r) { return r.samplesPerSecond; }, "%.0f").c_str(),
-                    medianRange(rs, [](auto& r) { return r.mraysPerSecond; }, "%.3f").c_str());
-      std::string stages;
-      for (std::size_t i = 0; i < rs.front().stageShare.size(); ++i) {
-        const std::string& stage = rs.front().stageShare[i].first;
-        auto share = [&](const BenchRun& r) {
-          for (auto& [n, v] : r.stageShare)
-            if (n == stage) return 100.0 * v;
-          return 0.0;
-        };
-        stages += (stages.empty() ? "" : ", ") + stage + " " + medianRange(rs, share, "%.1f") + "%";
+                    medianRange(rs, [](auto& r) { return r.mraysPerSecond; }, "%.3f").c_str(),
+                    medianRange(rs, [](auto& r) { return r.cpuCores; }, "%.2f").c_str(),
+                    medianRange(rs, [](auto& r) { return r.setupSeconds; }, "%.3f").c_str(),
+                    medianRange(rs, [](auto& r) { return r.warmupSeconds; }, "%.3f").c_str());
       }
-      if (!stages.empty())
-        std::printf("  %s, GPU time by stage%s: %s\n", traversalName(resolved[k]), a.repeats > 1 ? " (median [min-max])" : "",
-                    stages.c_str());
-    }
   }
   vk::destroyContext(ctx);
   return kExitOk;
@@ -475,6 +506,7 @@ int benchPipelinesCommand(int device) {
     RenderSettings s;
     s.width = s.height = 32;
     s.maxDepth = 2;
+    s.samplesPerPass = 1;  // the second pass times one sample per pixel
     auto t0 = std::chrono::steady_clock::now();
     Renderer r(ctx, scene, s);
     double create = r.summary().pipelineSeconds;
@@ -494,6 +526,7 @@ int benchPipelinesCommand(int device) {
 
 struct AlbedoArgs {
   std::string model;
+  std::string file;  // measured models
   std::vector<std::string> params;
   std::string set;
   double theta = 0;
@@ -504,11 +537,7 @@ struct AlbedoArgs {
 // incident direction at polar angle theta (azimuth phi), by adaptive quadrature.
 int albedoCommand(const AlbedoArgs& a) {
   const ModelSpec* spec = findModel(a.model);
-  if (!spec) {
-    std::string known;
-    for (const ModelSpec& m : allModels()) known += (known.empty() ? "" : ", ") + m.name;
-    throw Error("--model " + a.model + ": unknown model (known: " + known + ")");
-  }
+  if (!spec) throw Error("--model " + a.model + ": unknown model (known: " + knownModelNames() + ")");
   if (!(a.theta >= 0 && a.theta <= 90)) throw Error("--theta must be in [0, 90] degrees");
   NamedParams values;
   if (a.set == "typical") values = typicalParams(*spec);
@@ -518,7 +547,9 @@ int albedoCommand(const AlbedoArgs& a) {
     values.erase(std::remove_if(values.begin(), values.end(), [&](auto& e) { return e.first == kv.first; }), values.end());
     values.push_back(kv);
   }
-  BrdfParams params = packParams(*spec, values, "--model " + spec->name);
+  BrdfParams params = spec->measured ? measuredParams(*spec, a.file, a.params)
+                                     : packParams(*spec, values, "--model " + spec->name);
+  if (!spec->measured && !a.file.empty()) throw Error("--file: only measured models (merl) read a file");
   double rgb[3];
   directionalAlbedoRgb(spec->id, params, a.theta, a.phi, rgb);
   double lum = directionalAlbedo(spec->id, params, a.theta, a.phi);
@@ -558,6 +589,10 @@ int runCli(int argc, char** argv) {
       ->capture_default_str();
   render->add_option("--max-depth", ra.maxDepth, "Maximum path depth (0: emitted light only, 1: direct lighting)")
       ->capture_default_str()->check(CLI::Range(0u, 1024u));
+  render->add_option("--samples-per-pass", ra.samplesPerPass,
+                     "Samples per pixel traced together in one pass (0: enough for about 2^18 paths in flight on a "
+                     "CPU device, 2^21 on a GPU, at most 64); the image does not depend on it")
+      ->capture_default_str()->check(CLI::Range(0u, 4096u));
   render->add_option("--png", ra.png, "Also write a tone-mapped sRGB PNG");
   render->add_option("--exposure", ra.exposure, "Exposure of the PNG, in stops")->capture_default_str();
   render->add_option("--camera", ra.camera, "Use the glTF camera with this name (default: the first camera)");
@@ -610,6 +645,11 @@ int runCli(int argc, char** argv) {
       ->check(CLI::Range(1u, 1u << 20));
   benchRender->add_option("--width", ba.width, "Image width")->capture_default_str()->check(CLI::Range(1u, 65536u));
   benchRender->add_option("--height", ba.height, "Image height")->capture_default_str()->check(CLI::Range(1u, 65536u));
+  benchRender->add_option("--max-depth", ba.maxDepth, "Maximum path depth")->capture_default_str()
+      ->check(CLI::Range(0u, 1024u));
+  benchRender->add_option("--samples-per-pass", ba.samplesPerPass,
+                          "Samples per pixel per pass (0: chosen for the device, as render does)")
+      ->capture_default_str()->check(CLI::Range(0u, 4096u));
   benchRender->add_option("--device", ba.device, "Vulkan device index");
   benchRender->add_option("--traversal", ba.traversals, "Traversals to measure, interleaved within each repeat "
                                                          "(auto, rayquery, bvh; comma-separated or repeated)")
@@ -624,6 +664,7 @@ int runCli(int argc, char** argv) {
                                                   "luminance over the hemisphere), to at least 6 significant digits");
   albedo->add_option("--model", aa.model, "Model name (docs/models.md)")->required();
   albedo->add_option("--param", aa.params, "name=value or name=r,g,b (repeatable); others take their defaults");
+  albedo->add_option("--file", aa.file, "Measured models (merl): the MERL binary file (docs/measured.md)");
   albedo->add_option("--set", aa.set, "Start from the catalogue's typical or hard parameter set")
       ->check(CLI::IsMember({"typical", "hard"}));
   albedo->add_option("--theta", aa.theta, "Polar angle of the incident direction, degrees")->required();

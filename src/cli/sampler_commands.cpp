@@ -8,13 +8,17 @@
 #include <thread>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
+#include "brdf/merl.h"
 #include "brdf/registry.h"
+#include "cli/cli_common.h"
 #include "cli/commands.h"
 #include "render/settings.h"
 #include "quadtree/sample_run.h"
@@ -31,6 +35,7 @@ using namespace shared;
 
 struct SampleArgs {
   std::string model;
+  std::string file;  // measured models (merl)
   std::vector<std::string> params;
   std::string preset;  // typical (default) or hard
   double thetaDeg = 30;
@@ -67,11 +72,7 @@ BrdfParams paramsFor(const ModelSpec& m, const std::string& preset, const std::v
 
 const ModelSpec& modelOrThrow(const std::string& name) {
   const ModelSpec* m = findModel(name);
-  if (!m) {
-    std::string list;
-    for (const ModelSpec& s : allModels()) list += (list.empty() ? "" : ", ") + s.name;
-    throw Error("--model " + name + ": unknown model (one of " + list + ")");
-  }
+  if (!m) throw Error("--model " + name + ": unknown model (one of " + knownModelNames() + ")");
   if (m->delta) throw Error("--model " + name + ": a delta model is always sampled analytically (no strategy applies)");
   return *m;
 }
@@ -142,7 +143,8 @@ void writeSvg(const std::string& path, const quadtree::SamplerTables& t, std::ui
 int sampleCommand(const SampleArgs& a) {
   const ModelSpec& m = modelOrThrow(a.model);
   if (a.thetaDeg < 0 || a.thetaDeg >= 90) throw Error("--theta must lie in [0, 90)");
-  BrdfParams p = paramsFor(m, a.preset, a.params);
+  if (!m.measured && !a.file.empty()) throw Error("--file: only measured models (merl) read a file");
+  BrdfParams p = m.measured ? measuredParams(m, a.file, a.params) : paramsFor(m, a.preset, a.params);
   const std::uint32_t strategy = strategyId(a.sampler);
   if (strategy != SAMPLER_QUADTREE && !a.svg.empty()) throw Error("--svg draws the quadtree: only with --sampler quadtree");
   double th = a.thetaDeg * M_PI / 180, ph = a.phiDeg * M_PI / 180;
@@ -231,6 +233,7 @@ int sampleCommand(const SampleArgs& a) {
 
 struct BenchArgs {
   std::vector<std::string> models;
+  std::vector<std::string> files;  // measured materials (merl), one row each
   std::string preset = "typical";
   std::uint32_t thetaTables = 90;
   std::uint32_t phiTables = 16;
@@ -241,6 +244,8 @@ struct BenchArgs {
 // The time to build every model's trees (cache off), their size and shape, beside the paper's
 // start-up times; with --audit N, every leaf's envelope checked against f on an N x N lattice.
 int benchPrecompute(const BenchArgs& a) {
+  if (std::find(a.models.begin(), a.models.end(), "merl") != a.models.end() && a.files.empty())
+    throw Error("--model merl needs --file, a MERL binary file (docs/measured.md)");
   static const std::map<std::string, double> paper = {
       {"ashikhmin_shirley", 51.4}, {"beard_maxwell", 15.5}, {"blinn", 8.7}, {"coupled", 22.6},
       {"htsg", 102.7}, {"lafortune", 6.6}, {"lewis", 6.9}, {"minnaert", 7.3}, {"oren_nayar", 10.5},
@@ -255,10 +260,19 @@ int benchPrecompute(const BenchArgs& a) {
   std::printf("\n");
   double sum = 0, worstAudit = 0;
   int count = 0, under = 0;
+  // The analytic models (unless --model leaves them out), then one measured material per --file.
+  std::vector<std::tuple<std::string, const ModelSpec*, BrdfParams>> rows;
   for (const ModelSpec& m : allModels()) {
     if (m.delta) continue;
     if (!a.models.empty() && std::find(a.models.begin(), a.models.end(), m.name) == a.models.end()) continue;
-    BrdfParams p = paramsFor(m, a.preset, {});
+    rows.emplace_back(m.name, &m, paramsFor(m, a.preset, {}));
+  }
+  for (const std::string& f : a.files) {
+    const ModelSpec& m = *findModel("merl");
+    rows.emplace_back("merl-" + std::filesystem::path(f).filename().string(), &m, measuredParams(m, f, {}));
+  }
+  for (const auto& [name, model, p] : rows) {
+    const ModelSpec& m = *model;
     quadtree::QuadtreeSettings qs;
     qs.useCache = false;
     qs.thetaTables = a.thetaTables;
@@ -272,7 +286,7 @@ int benchPrecompute(const BenchArgs& a) {
     if (it != paper.end()) std::snprintf(ps, sizeof ps, "%.1f", it->second);
     std::uint32_t singular = 0;
     for (const QuadLeaf& l : t.leaves) singular += l.env.z > 0.0f ? 1u : 0u;
-    std::printf("%-17s %5u %8.3f %7u %7.0f %8.1f %6u %6u %6u %5u %5u %5u %6.3f %7s", m.name.c_str(), s.trees, t.seconds, s.leaves,
+    std::printf("%-17s %5u %8.3f %7u %7.0f %8.1f %6u %6u %6u %5u %5u %5u %6.3f %7s", name.c_str(), s.trees, t.seconds, s.leaves,
                 double(s.bytes) / s.trees, s.bytes / 1024.0, s.rimLeaves, s.expLeaves, singular, s.tailLeaves, s.cappedLeaves,
                 s.maxDepth, s.minAcceptance, ps);
     if (a.audit) {
@@ -288,6 +302,17 @@ int benchPrecompute(const BenchArgs& a) {
       worstAudit = std::max(worstAudit, worst);
     }
     std::printf("\n");
+    if (m.measured) {
+      // The table itself: rgb floats on the GPU; the CPU keeps them, the node luminances and their
+      // max pyramid (the builder's bounds).
+      const MerlTable& mt = merlTable(p);
+      std::uint64_t cpu = (mt.rgb.size() + mt.luminance.size()) * sizeof(float);
+      for (const auto& level : mt.pyramid) cpu += level.size() * sizeof(float);
+      std::printf("  %s: table %.1f KiB on the GPU (%u floats), %.1f KiB on the CPU; trees %.1f KiB; %u nodes not measured; "
+                  "%.2f M evaluations of f, %.2f s of CPU\n",
+                  name.c_str(), MERL_TABLE_FLOATS * 4 / 1024.0, unsigned(MERL_TABLE_FLOATS), cpu / 1024.0, s.bytes / 1024.0,
+                  mt.unmeasured, s.evaluations / 1e6, s.buildSeconds);
+    }
     std::fflush(stdout);
     sum += t.seconds;
     under += t.seconds < 0.2 ? 1 : 0;
@@ -312,6 +337,7 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
   CLI::App* sample = app.add_subcommand("sample", "Draw directions with a BSDF sampling strategy (default: the generic quadtree sampler; CSV: x,y,z,pdf,f)");
   sample->add_option("--model", sa->model, "Reflectance model")->required();
   sample->add_option("--param", sa->params, "name=value (repeatable); overrides the preset");
+  sample->add_option("--file", sa->file, "Measured models (merl): the MERL binary file (docs/measured.md)");
   sample->add_option("--preset", sa->preset, "Parameter set: typical (default) or hard")->check(CLI::IsMember({"typical", "hard"}));
   sample->add_option("--theta", sa->thetaDeg, "Polar angle of the known direction (sin t cos p, sin t sin p, cos t), degrees")->required();
   sample->add_option("--phi", sa->phiDeg, "Azimuth of the known direction, degrees")->capture_default_str();
@@ -333,6 +359,8 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
   auto ba = std::make_shared<BenchArgs>();
   CLI::App* pre = bench.add_subcommand("precompute", "Time to build the trees of every model (cache disabled), beside the paper's start-up times");
   pre->add_option("--model", ba->models, "Only these models (repeatable)");
+  pre->add_option("--file", ba->files, "Also a measured material (merl) from this MERL binary file (repeatable)")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   pre->add_option("--preset", ba->preset, "typical (default) or hard")->check(CLI::IsMember({"typical", "hard"}));
   pre->add_option("--theta-tables", ba->thetaTables, "Tables along theta")->capture_default_str()->check(CLI::Range(1u, 4096u));
   pre->add_option("--phi-tables", ba->phiTables, "Tables along phi (anisotropic models)")->capture_default_str()->check(CLI::Range(2u, 1024u));

@@ -14,6 +14,8 @@
 // with its sub-cells' sum.
 #include "quadtree/quadtree_build.h"
 
+#include "brdf/merl.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -274,11 +276,163 @@ struct Envelope {
   double trialV = 0;  // ... over its proposal domain (cost: trials, incl. discarded points)
 };
 
+// ---- Exact bounds of a measured table (merl) over a region of the disc ----------------------------
+// The interpolant of shaders/shared/brdf/merl.h is multilinear in the table coordinates
+// u = (u_h, u_d, u_p) inside each table cell, so over a box [lo, hi] of u its maximum lies on the
+// grid {lo, the integer nodes between, hi} of each axis: evaluating it there gives the exact
+// maximum over the box. A region of the disc maps to a curved set of u; interval arithmetic on the
+// coordinate change encloses it in a box, so the maximum over that box bounds f over the region.
+struct Interval {
+  double lo, hi;
+};
+Interval iv(double a, double b) { return {std::min(a, b), std::max(a, b)}; }
+Interval operator+(Interval a, Interval b) { return {a.lo + b.lo, a.hi + b.hi}; }
+Interval operator-(Interval a, Interval b) { return {a.lo - b.hi, a.hi - b.lo}; }
+Interval operator*(Interval a, Interval b) {
+  double p[4] = {a.lo * b.lo, a.lo * b.hi, a.hi * b.lo, a.hi * b.hi};
+  return {*std::min_element(p, p + 4), *std::max_element(p, p + 4)};
+}
+Interval operator*(double s, Interval a) { return iv(s * a.lo, s * a.hi); }
+Interval sq(Interval a) {
+  if (a.lo >= 0) return {a.lo * a.lo, a.hi * a.hi};
+  if (a.hi <= 0) return {a.hi * a.hi, a.lo * a.lo};
+  return {0, std::max(a.lo * a.lo, a.hi * a.hi)};
+}
+Interval sqrtI(Interval a) { return {std::sqrt(std::max(a.lo, 0.0)), std::sqrt(std::max(a.hi, 0.0))}; }
+// a / b for b > 0.
+Interval divPos(Interval a, Interval b) {
+  double p[4] = {a.lo / b.lo, a.lo / b.hi, a.hi / b.lo, a.hi / b.hi};
+  return {*std::min_element(p, p + 4), *std::max_element(p, p + 4)};
+}
+// cos and sin over [p0, p1] (radians, p1 - p0 <= 2 pi).
+Interval cosRange(double p0, double p1) {
+  double lo = std::min(std::cos(p0), std::cos(p1)), hi = std::max(std::cos(p0), std::cos(p1));
+  for (int k = int(std::ceil(p0 / M_PI)); k * M_PI <= p1; ++k) (k % 2 == 0 ? hi : lo) = (k % 2 == 0 ? 1.0 : -1.0);
+  return {lo, hi};
+}
+Interval sinRange(double p0, double p1) { return cosRange(p0 - M_PI / 2, p1 - M_PI / 2); }
+
+// Luminance of the interpolant at table coordinates (u_h, u_d, u_p) in double (brdf/merl.h's
+// merlLookup on the node luminances).
+double merlLumAt(const MerlTable& t, double uh, double ud, double up) {
+  uh = std::clamp(uh, 0.0, 89.0);
+  ud = std::clamp(ud, 0.0, 89.0);
+  up = std::fmod(up, 180.0);
+  if (up < 0) up += 180;
+  int i0 = std::min(int(uh), 88), j0 = std::min(int(ud), 88), k0 = std::min(int(up), 179);
+  int k1 = k0 + 1 == 180 ? 0 : k0 + 1;
+  double fi = uh - i0, fj = ud - j0, fk = up - k0;
+  auto n = [&](int i, int j, int k) { return double(t.luminance[(std::size_t(i) * 90 + std::size_t(j)) * 180 + std::size_t(k)]); };
+  auto lk = [&](int i, int j) { return n(i, j, k0) + fk * (n(i, j, k1) - n(i, j, k0)); };
+  double c0 = lk(i0, j0) + fj * (lk(i0, j0 + 1) - lk(i0, j0));
+  double c1 = lk(i0 + 1, j0) + fj * (lk(i0 + 1, j0 + 1) - lk(i0 + 1, j0));
+  return c0 + fi * (c1 - c0);
+}
+
+// The exact maximum of the interpolant over the u box (grid of box ends and nodes between), or,
+// for a box spanning more than 512 grid points, the largest node of the cells it meets.
+double merlBoxMax(const MerlTable& t, Interval uh, Interval ud, Interval up) {
+  uh = {std::clamp(uh.lo, 0.0, 89.0), std::clamp(uh.hi, 0.0, 89.0)};
+  ud = {std::clamp(ud.lo, 0.0, 89.0), std::clamp(ud.hi, 0.0, 89.0)};
+  if (up.hi - up.lo >= 179) up = {0, 180};
+  auto axis = [](Interval a, std::vector<double>& out) {
+    out.clear();
+    out.push_back(a.lo);
+    for (double k = std::floor(a.lo) + 1; k < a.hi; k += 1) out.push_back(k);
+    out.push_back(a.hi);
+  };
+  static thread_local std::vector<double> A, B, C;
+  axis(uh, A);
+  axis(ud, B);
+  if (up.hi - up.lo >= 179 && A.size() * B.size() <= 4096) {
+    // Every phi_d: the interpolant at (u_h, u_d) is at most the bilinear interpolation of the
+    // nodes' maxima over phi_d, whose maximum over the box is on its grid.
+    auto M = [&](int i, int j) { return double(t.maxOverPhi[std::size_t(i) * 90 + std::size_t(j)]); };
+    double m = 0;
+    for (double a : A)
+      for (double b : B) {
+        int i0 = std::min(int(a), 88), j0 = std::min(int(b), 88);
+        double fi = a - i0, fj = b - j0;
+        double c0 = M(i0, j0) + fj * (M(i0, j0 + 1) - M(i0, j0)), c1 = M(i0 + 1, j0) + fj * (M(i0 + 1, j0 + 1) - M(i0 + 1, j0));
+        m = std::max(m, c0 + fi * (c1 - c0));
+      }
+    return m;
+  }
+  axis(up, C);
+  if (A.size() * B.size() * C.size() > 512)
+    return merlNodeMax(t, int(uh.lo), int(uh.hi) + 1, int(ud.lo), int(ud.hi) + 1, int(std::floor(up.lo)),
+                       int(std::floor(up.hi)) + 1);
+  double m = 0;
+  for (double a : A)
+    for (double b : B)
+      for (double c : C) m = std::max(m, merlLumAt(t, a, b, c));
+  return m;
+}
+
+// An upper bound of luminance(f(w, v)) over the w in the box x * y * z (disc coordinates and
+// cos theta; v fixed, v.z >= 0).
+double merlRegionBound(const MerlTable& t, vec3 v, Interval x, Interval y, Interval z) {
+  const double vx = v.x, vy = v.y, vz = v.z;
+  // f(., v) is symmetric in w.y for v.y = 0 (isotropic): bound over |w.y| (a padded polar box
+  // reaches 1e-6 below the seam y = 0).
+  if (vy == 0 && y.lo < 0) y = y.hi <= 0 ? Interval{-y.hi, -y.lo} : Interval{0, std::max(-y.lo, y.hi)};
+  // Widening of the table coordinates: covers the float rounding of the shared evaluation.
+  const double pad = 0.01;
+  Interval d = vx * x + vy * y + vz * z;  // w . v
+  d = {std::clamp(d.lo, -1.0, 1.0), std::clamp(d.hi, -1.0, 1.0)};
+  // cos theta_d = |w + v| / 2 = sqrt((1 + w.v) / 2)
+  Interval cd = sqrtI({(1 + d.lo) / 2, (1 + d.hi) / 2});
+  Interval thetaD = {std::acos(std::min(cd.hi, 1.0)), std::acos(std::min(cd.lo, 1.0))};
+  // theta_h = atan(rho / (w.z + v.z)), rho = |(w + v)_xy|: numerator and denominator depend on
+  // different coordinates, so the quotient's interval is tight (cos theta_h = (w.z + v.z) / |w + v|
+  // would tie both to w and, near w = -v, lose degrees to the box's corners off the sphere).
+  Interval rhoH = sqrtI(sq(x + Interval{vx, vx}) + sq(y + Interval{vy, vy}));
+  Interval zv = z + Interval{vz, vz};
+  Interval thetaH = {0, M_PI / 2};
+  if (zv.lo > 0) thetaH = {std::atan(rhoH.lo / zv.hi), std::atan(rhoH.hi / zv.lo)};
+  else if (zv.hi > 0) thetaH = {std::atan(rhoH.lo / zv.hi), M_PI / 2};
+  const double k = 2 / M_PI;
+  Interval uh = {90 * std::sqrt(thetaH.lo * k) - pad, 90 * std::sqrt(thetaH.hi * k) + pad};
+  Interval ud = {90 * thetaD.lo * k - pad, 90 * thetaD.hi * k + pad};
+  Interval up = {0, 180};
+  // phi_d: w = cos(theta_d) h + sin(theta_d) (cos(phi_d) t + sin(phi_d) b) with t.z = -sin(theta_h),
+  // so w.z = cos(theta_d) cos(theta_h) - sin(theta_d) sin(theta_h) cos(phi_d); cos(theta_d)
+  // cos(theta_h) = (w.z + v.z) / 2, sin(theta_d) sin(theta_h) = rho sqrt((1 - w.v) / (1 + w.v)) / 2
+  // with rho = |(w + v)_xy|:  cos(phi_d) = (v.z - w.z) / (rho sqrt((1 - w.v) / (1 + w.v))).
+  // The sets of an isotropic model have v.y = 0, v.x >= 0 and w.y >= 0 (half disc), where
+  // sin(phi_d) = v.x w.y / (rho sin(theta_d)) >= 0: phi_d = acos(cos(phi_d)) in [0, pi].
+  Interval wx = x + Interval{vx, vx}, wy = y + Interval{vy, vy};
+  Interval rho = sqrtI(sq(wx) + sq(wy));
+  if (vy == 0 && y.lo >= 0 && rho.lo > 1e-9 && d.hi < 1 - 1e-12 && d.lo > -1 + 1e-12) {
+    Interval ratio = sqrtI(divPos({1 - d.hi, 1 - d.lo}, {1 + d.lo, 1 + d.hi}));
+    Interval den = rho * ratio;
+    if (den.lo > 1e-12) {
+      Interval cp = divPos(Interval{vz, vz} - z, den);
+      cp = {std::clamp(cp.lo, -1.0, 1.0), std::clamp(cp.hi, -1.0, 1.0)};
+      double p0 = std::acos(cp.hi), p1 = std::acos(cp.lo);
+      // Near the plane of incidence rho is small and the cosine loose; sin(phi_d) = v.x w.y /
+      // (rho sin(theta_d)) in [0, sMax] keeps phi_d within asin(sMax) of 0 or pi.
+      Interval sd = sqrtI({(1 - d.hi) / 2, (1 - d.lo) / 2});
+      if (sd.lo > 1e-12) {
+        double sMax = vx * y.hi / (rho.lo * sd.lo);
+        if (sMax < 1) {
+          double a = std::asin(sMax);
+          if (p0 >= M_PI / 2) p0 = std::max(p0, M_PI - a);
+          else if (p1 <= M_PI / 2) p1 = std::min(p1, a);
+        }
+      }
+      up = {p0 * 180 / M_PI - pad, p1 * 180 / M_PI + pad};
+    }
+  }
+  return merlBoxMax(t, uh, ud, up);
+}
+
 class Builder {
  public:
   Builder(std::uint32_t model, const BrdfParams& params, vec3 v, bool halfDisc, const BuildSettings& s)
       : m_model(model), m_params(params), m_v(v), m_half(halfDisc), m_s(s) {
     m_traits = modelTraits(model, params);
+    if (model == MODEL_MERL) m_merl = &merlTable(params);
     collectPeaks();
   }
   Tree build();
@@ -299,6 +453,8 @@ class Builder {
   };
   std::vector<Ridge> m_ridges;
   std::uint64_t m_evals = 0;
+  const MerlTable* m_merl = nullptr;  // merl: the table (exact bounds, certify)
+  std::uint64_t m_certifyBoxes = 0;
   std::vector<RulePoint> m_rx, m_ry;
   double m_aEst = 0;
 
@@ -345,6 +501,7 @@ class Builder {
   Frame frameOf(const Cell& c, PolarBox* box) const;
   Envelope fit(const Cell& c, const Frame& fr, const CellResult& all, const std::vector<Pt>& quad);
   void polish(const Cell& c, const Frame& fr, CellResult& all, Envelope& env, int lattice);
+  void certify(const Frame& fr, Envelope& env);
   double tolerance(double q) const { return std::max(m_s.relTol * std::abs(q), m_s.absTol * m_aEst); }
 };
 
@@ -883,6 +1040,61 @@ void Builder::polish(const Cell& cell, const Frame& fr, CellResult& all, Envelop
   }
 }
 
+// merl: makes the envelope a proven bound. The leaf's proposal domain is covered by boxes of
+// proposal coordinates; a box is proven when the envelope's minimum over it (at a corner: the
+// exponential is monotone along each axis) is at least the exact bound of f over it
+// (merlRegionBound); unproven boxes are split four ways (down to 1/64 of the domain), and the
+// envelope is scaled by the largest bound / minimum left.
+void Builder::certify(const Frame& fr, Envelope& env) {
+  const double safety = 1.001;  // float rounding of the shared evaluation and of the envelope
+  struct Box {
+    double a0, a1, b0, b1;
+    int depth;
+  };
+  std::vector<Box> stack{{0, 1, 0, 1, 0}};
+  double worst = 0;
+  while (!stack.empty()) {
+    Box b = stack.back();
+    stack.pop_back();
+    ++m_certifyBoxes;
+    Interval x, y, z;
+    if (fr.kind == QT_PROPOSAL_SQUARE) {
+      x = {fr.a0 + b.a0 * (fr.a1 - fr.a0), fr.a0 + b.a1 * (fr.a1 - fr.a0)};
+      y = {fr.b0 + b.b0 * (fr.b1 - fr.b0), fr.b0 + b.b1 * (fr.b1 - fr.b0)};
+      Interval r2 = sq(x) + sq(y);
+      if (r2.lo >= 1) continue;  // outside the disc: never sampled
+      z = sqrtI({1 - std::min(r2.hi, 1.0), 1 - r2.lo});
+    } else {
+      double u0 = fr.a0 * fr.a0, u1 = fr.a1 * fr.a1;
+      Interval c2 = {u0 + b.a0 * (u1 - u0), u0 + b.a1 * (u1 - u0)};
+      z = sqrtI(c2);
+      Interval r = sqrtI({1 - c2.hi, 1 - c2.lo});
+      double p0 = M_PI * (fr.b0 + b.b0 * (fr.b1 - fr.b0)), p1 = M_PI * (fr.b0 + b.b1 * (fr.b1 - fr.b0));
+      x = r * cosRange(p0, p1);
+      y = r * sinRange(p0, p1);
+    }
+    double bound = safety * merlRegionBound(*m_merl, m_v, x, y, z);
+    if (bound <= 0) continue;
+    double e = env.A * std::exp(std::min(env.k1 * (b.a0 - 0.5), env.k1 * (b.a1 - 0.5)) +
+                                std::min(env.k2 * (b.b0 - 0.5), env.k2 * (b.b1 - 0.5)));
+    if (bound <= e) continue;
+    if (b.depth < 6 && m_certifyBoxes < (1u << 30)) {
+      double am = 0.5 * (b.a0 + b.a1), bm = 0.5 * (b.b0 + b.b1);
+      stack.push_back({b.a0, am, b.b0, bm, b.depth + 1});
+      stack.push_back({am, b.a1, b.b0, bm, b.depth + 1});
+      stack.push_back({b.a0, am, bm, b.b1, b.depth + 1});
+      stack.push_back({am, b.a1, bm, b.b1, b.depth + 1});
+      continue;
+    }
+    worst = std::max(worst, e > 0 ? bound / e : INFINITY);
+  }
+  if (worst > 1) {  // e > 0 everywhere (A > 0, |k| <= 40), so worst is finite
+    env.A *= worst;
+    env.V *= worst;
+    env.trialV *= worst;
+  }
+}
+
 struct Item {
   Cell cell;
   std::uint32_t parent, slot;
@@ -995,6 +1207,7 @@ Tree Builder::build() {
     }
     if (leaf && mass > 0) {
       polish(cell, fr, all, env, accepts(mass, env) ? 0 : kLowLeafLattice);
+      if (m_merl) certify(fr, env);
       if (!capped && !(accepts(mass, env) || tailOk(mass, env))) {
         leaf = false;  // the envelope had to grow: split after all
         running -= mass - sumq;

@@ -1,6 +1,8 @@
 // sample_run.cpp: see sample_run.h.
 #include "quadtree/sample_run.h"
 
+#include "brdf/merl.h"
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -119,6 +121,11 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
   GpuMaterial mat{};
   mat.info = uvec4(model, 0u, set, 0u);
   mat.params = params;
+  // A measured table goes to the GPU as table 0 of the measured buffer.
+  const bool measured = model == MODEL_MERL;
+  if (measured) mat.params.v[0][MERL_SLOT] = 0.0f;
+  vk::Buffer measuredTables = measured ? upload(merlTable(params).rgb.data(), MERL_TABLE_FLOATS * sizeof(float), "measured table")
+                                       : upload(nullptr, 0, "measured table");
   vk::Buffer materials = upload(&mat, sizeof mat, "sampler materials");
   vk::Buffer sets = upload(tables.sets.data(), tables.sets.size() * sizeof(QuadSet), "quadtree sets");
   vk::Buffer tabs = upload(tables.tables.data(), tables.tables.size() * sizeof(QuadTable), "quadtree tables");
@@ -147,6 +154,7 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
   g.tabSets = tSets.address;
   g.tabTables = tTables.address;
   g.tabData = tData.address;
+  g.measured = measuredTables.address;
 
   // Binding 0 = the Globals block, as the renderer's stages.
   std::memcpy(globals.mapped, &g, sizeof g);
@@ -196,7 +204,7 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
 
   vk::destroyComputePipeline(ctx, pipe);
   vk::destroyGlobalsBinding(ctx, binding);
-  for (vk::Buffer* b : {&materials, &sets, &tabs, &nodes, &leaves, &tSets, &tTables, &tData, &film, &filmSq, &stats, &globals}) vk::destroyBuffer(ctx, *b);
+  for (vk::Buffer* b : {&measuredTables, &materials, &sets, &tabs, &nodes, &leaves, &tSets, &tTables, &tData, &film, &filmSq, &stats, &globals}) vk::destroyBuffer(ctx, *b);
   return out;
 }
 

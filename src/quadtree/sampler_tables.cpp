@@ -224,7 +224,11 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
         double relTol, absTol;
       } kd{kFormatVersion, model, u.nTheta, u.nPhi, bs.maxDepth, bs.nMax, bs.boundMargin, bs.relTol, bs.absTol};
       std::uint64_t key = fnv1a(&kd, sizeof kd);
-      u.key = fnv1a(&u.params, sizeof(BrdfParams), key);
+      // A measured table is keyed by its content hash (in the block), not by its slot, which
+      // depends on the order in which a run loaded its files.
+      BrdfParams keyParams = u.params;
+      if (model == MODEL_MERL) keyParams.v[0][MERL_SLOT] = 0.0f;
+      u.key = fnv1a(&keyParams, sizeof(BrdfParams), key);
       uniques.push_back(std::move(u));
     }
     setIndexPerMaterial[i] = it->second;

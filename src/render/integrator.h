@@ -44,14 +44,18 @@ class StageGlobals {
 class Integrator {
  public:
   virtual ~Integrator() = default;
-  // Adds one sample per pixel to the film: the pass of sample index `sampleIndex` (the same index
-  // gives the same samples, so resumed and split renders equal uninterrupted ones).
-  virtual void renderPass(std::uint32_t sampleIndex) = 0;
+  // Adds `samples` samples per pixel to the film, sample indices sampleIndex .. sampleIndex +
+  // samples - 1 (the same index gives the same sample, so resumed and split renders equal
+  // uninterrupted ones, whatever the samples per pass).
+  virtual void renderPass(std::uint32_t sampleIndex, std::uint32_t samples) = 0;
   // Counters summed over all passes so far, plus what addStats carried over.
   virtual RenderStats stats() const = 0;
   virtual void addStats(const RenderStats& carried) = 0;
   // GPU time per stage name summed over all passes (empty unless RenderSettings::timeStages).
   virtual const std::vector<std::pair<std::string, double>>& stageSeconds() const = 0;
+  // Extension rays traced per bounce (index = bounce; the last entry also counts deeper bounces),
+  // summed over all passes so far.
+  virtual const std::vector<std::uint64_t>& raysPerBounce() const = 0;
   // Device bytes of the integrator's own state.
   virtual std::uint64_t deviceBytes() const = 0;
 };

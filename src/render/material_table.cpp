@@ -7,6 +7,7 @@
 
 #include "../../shaders/shared/layout.h"
 #include "brdf/albedo.h"
+#include "brdf/merl.h"
 #include "quadtree/sampler_tables.h"
 #include "sampling/tabulated.h"
 #include "util/error.h"
@@ -133,6 +134,18 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     return INVALID_INDEX;
   };
 
+  // ---- Measured tables (merl): each distinct table once, in the order first used; the GPU blocks
+  // carry the table's index in this buffer instead of the CPU store's slot ----
+  std::vector<std::uint32_t> measuredSlots;
+  auto gpuMeasured = [&](std::uint32_t model, shared::BrdfParams& p) {
+    if (model != MODEL_MERL) return;
+    std::uint32_t cpuSlot = merlSlot(p);
+    auto it = std::find(measuredSlots.begin(), measuredSlots.end(), cpuSlot);
+    std::uint32_t index = static_cast<std::uint32_t>(it - measuredSlots.begin());
+    if (it == measuredSlots.end()) measuredSlots.push_back(cpuSlot);
+    p.v[0][MERL_SLOT] = static_cast<float>(index);
+  };
+
   // ---- GPU materials and components, packed once ----
   const bool maxChannelChoice = settings.roulette == RouletteMode::Throughput;
   std::vector<GpuMaterial> materials(std::max<std::size_t>(scene.materials.size(), 1));
@@ -155,6 +168,7 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
                           src.combined() ? INVALID_INDEX : setFor(material, -1), slot);
     dst.emission = v4(src.emission);
     dst.params = src.params;
+    if (used[i] && !src.combined()) gpuMeasured(src.model, dst.params);
     dst.components = glm::uvec4(0u);
     if (!src.combined() || !used[i]) continue;
     dst.components = glm::uvec4(static_cast<std::uint32_t>(components.size()),
@@ -170,6 +184,7 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
       const bool delta = modelById(c.model).delta;
       const bool readsQuadAlbedo = settings.sampler == SamplerKind::Quadtree && gc.info.y != INVALID_INDEX;
       if (!delta && (maxChannelChoice || !readsQuadAlbedo)) tabulateComponentAlbedo(gc, maxChannelChoice);
+      gpuMeasured(c.model, gc.params);
       components.push_back(gc);
     }
   }
@@ -189,18 +204,26 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
   make(m_tabSets, tab.sets.size(), sizeof(shared::TabSet), "tabulated sets", tab.sets.data());
   make(m_tabTables, tab.tables.size(), sizeof(shared::TabTable), "tabulated tables", tab.tables.data());
   make(m_tabData, tab.data.size(), sizeof(float), "tabulated cdfs", tab.data.data());
+  m_measured = vk::createBuffer(m_ctx, std::max<std::size_t>(measuredSlots.size() * MERL_TABLE_FLOATS, 1) * sizeof(float), 0,
+                                false, "measured tables");
+  for (std::size_t k = 0; k < measuredSlots.size(); ++k) {
+    shared::BrdfParams p{};
+    p.v[0][MERL_SLOT] = static_cast<float>(measuredSlots[k]);
+    vk::uploadBuffer(m_ctx, m_measured, merlTable(p).rgb.data(), MERL_TABLE_FLOATS * sizeof(float),
+                     k * MERL_TABLE_FLOATS * sizeof(float));
+  }
 }
 
 MaterialTable::~MaterialTable() {
   for (vk::Buffer* b : {&m_materials, &m_components, &m_quadSets, &m_quadTables, &m_quadNodes, &m_quadLeaves,
-                        &m_tabSets, &m_tabTables, &m_tabData})
+                        &m_tabSets, &m_tabTables, &m_tabData, &m_measured})
     vk::destroyBuffer(m_ctx, *b);
 }
 
 std::uint64_t MaterialTable::deviceBytes() const {
   std::uint64_t total = 0;
   for (const vk::Buffer* b : {&m_materials, &m_components, &m_quadSets, &m_quadTables, &m_quadNodes, &m_quadLeaves,
-                              &m_tabSets, &m_tabTables, &m_tabData})
+                              &m_tabSets, &m_tabTables, &m_tabData, &m_measured})
     total += b->size;
   return total;
 }
@@ -215,6 +238,7 @@ void MaterialTable::fillGlobals(shared::Globals& g) const {
   g.tabSets = m_tabSets.address;
   g.tabTables = m_tabTables.address;
   g.tabData = m_tabData.address;
+  g.measured = m_measured.address;
   g.materialCount = static_cast<std::uint32_t>(std::max<std::size_t>(m_materialCount, 1));
 }
 

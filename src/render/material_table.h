@@ -57,6 +57,7 @@ class MaterialTable {
   vk::Buffer m_materials, m_components;
   vk::Buffer m_quadSets, m_quadTables, m_quadNodes, m_quadLeaves;
   vk::Buffer m_tabSets, m_tabTables, m_tabData;
+  vk::Buffer m_measured;  // measured BRDF tables (merl), MERL_TABLE_FLOATS floats each
 };
 
 }  // namespace nusselt

@@ -16,9 +16,21 @@ using shared::Globals;
 using shared::BounceConstants;
 using shared::SubmitConstants;
 
-std::uint32_t PathIntegrator::capacityFor(const RenderSettings& settings, std::uint64_t pixels) {
+std::uint32_t PathIntegrator::capacityFor(const RenderSettings& settings, std::uint64_t pixels, std::uint32_t samples) {
   std::uint32_t maxChunk = std::min<std::uint32_t>(settings.maxPathsPerChunk, 65535u * WORKGROUP_SIZE);
-  return static_cast<std::uint32_t>(std::min<std::uint64_t>(pixels, maxChunk));
+  return static_cast<std::uint32_t>(std::min<std::uint64_t>(pixels * std::max(1u, samples), maxChunk));
+}
+
+std::uint32_t PathIntegrator::samplesPerPassFor(const RenderSettings& settings, std::uint64_t pixels, bool cpuDevice) {
+  std::uint64_t k = settings.samplesPerPass;
+  if (k == 0) {
+    const std::uint64_t target = cpuDevice ? (1u << 18) : (1u << 21);
+    k = std::clamp<std::uint64_t>(target / std::max<std::uint64_t>(pixels, 1), 1, 64);
+  }
+  k = std::min<std::uint64_t>(k, std::max<std::uint32_t>(settings.spp, 1));
+  // Path numbers (pixel x samples + k) are 32-bit on the device.
+  k = std::min<std::uint64_t>(k, std::max<std::uint64_t>(1, 0xffffffffull / std::max<std::uint64_t>(pixels, 1)));
+  return static_cast<std::uint32_t>(std::max<std::uint64_t>(k, 1));
 }
 
 std::uint64_t PathIntegrator::bytesFor(std::uint32_t capacity, std::size_t slots) {
@@ -27,9 +39,12 @@ std::uint64_t PathIntegrator::bytesFor(std::uint32_t capacity, std::size_t slots
 }
 
 PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
-                               const std::vector<std::vector<std::uint32_t>>& slotKeys, std::uint64_t pixels)
+                               const std::vector<std::vector<std::uint32_t>>& slotKeys, std::uint64_t pixels,
+                               std::uint32_t samplesPerPass, const std::vector<std::string>& slotNames)
     : m_ctx(ctx), m_globals(globals), m_settings(settings), m_slotKeys(slotKeys), m_pixels(pixels) {
-  m_capacity = capacityFor(settings, pixels);
+  for (std::size_t s = 0; s < m_slotKeys.size(); ++s)
+    m_shadeMarks.push_back("shade " + (s < slotNames.size() ? slotNames[s] : std::to_string(s)));
+  m_capacity = capacityFor(settings, pixels, samplesPerPass);
   const std::uint64_t cap = m_capacity;
   auto make = [&](VkDeviceSize bytes, const std::string& what, VkBufferUsageFlags usage = 0,
                   bool host = false) -> vk::Buffer* {
@@ -52,8 +67,9 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   g.queues = m_queues->address;
   m_args = make(QUEUE_COUNT * sizeof(DispatchArgs), "dispatch arguments", VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
   g.dispatchArgs = m_args->address;
-  m_stats = make(STAT_COUNT * 4, "statistics", 0, true);
-  std::memset(m_stats->mapped, 0, STAT_COUNT * 4);
+  m_stats = make(STAT_BUFFER_UINTS * 4, "statistics", 0, true);
+  std::memset(m_stats->mapped, 0, STAT_BUFFER_UINTS * 4);
+  m_raysPerBounce.assign(STAT_BOUNCE_SLOTS, 0);
   g.stats = m_stats->address;
   g.maxDepth = m_settings.maxDepth;
   g.pathCapacity = m_capacity;
@@ -70,7 +86,7 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VK_CHECK(vkCreateFence(m_ctx.device, &fci, nullptr, &m_fence));
   if (settings.timeStages && m_ctx.properties.limits.timestampComputeAndGraphics) {
-    m_queryCapacity = 8 + (settings.maxDepth + 1) * 8;
+    m_queryCapacity = 8 + (settings.maxDepth + 1) * (8 + std::uint32_t(m_slotKeys.size()));
     VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
     q.queryType = VK_QUERY_TYPE_TIMESTAMP;
     q.queryCount = m_queryCapacity;
@@ -147,8 +163,10 @@ void PathIntegrator::createPipelines() {
 }
 
 void PathIntegrator::dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst,
-                                    std::uint32_t zeroCount, std::uint32_t argsFirst, std::uint32_t argsCount) {
+                                    std::uint32_t zeroCount, std::uint32_t argsFirst, std::uint32_t argsCount,
+                                    std::uint32_t bounce) {
   SubmitConstants pc{};
+  pc.bounce = bounce;
   pc.argsQueue = queueA;
   pc.argsFirst = argsFirst;
   pc.argsCount = argsCount;
@@ -187,7 +205,7 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
     const std::uint32_t rayQueue = bounce & 1u;
     pc.bounce = bounce;
     // intersect <- ray queue; empties the shadow queue of the previous bounce.
-    dispatchSubmit(cmd, rayQueue, QUEUE_SHADOW, 1, 0, 0);
+    dispatchSubmit(cmd, rayQueue, QUEUE_SHADOW, 1, 0, 0, bounce);
     mark(cmd, "submit");
     bindAndPush(m_intersect);
     vkCmdDispatchIndirect(cmd, m_args->buffer, rayQueue * sizeof(DispatchArgs));
@@ -200,9 +218,12 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
       pc.modelSlot = s;
       bindAndPush(m_shade[s]);
       vkCmdDispatchIndirect(cmd, m_args->buffer, (QUEUE_SHADE_BASE + s) * sizeof(DispatchArgs));
+      if (m_queryPool) {  // timed runs only: each shade pipeline on its own (a barrier between them)
+        vk::computeBarrier(cmd);
+        mark(cmd, m_shadeMarks[s].c_str());
+      }
     }
     vk::computeBarrier(cmd);
-    mark(cmd, "shade");
     // shadow <- shadow queue; empties the shade queues.
     dispatchSubmit(cmd, QUEUE_SHADOW, QUEUE_SHADE_BASE, slots, 0, 0);
     mark(cmd, "submit");
@@ -217,13 +238,17 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
   mark(cmd, "accumulate");
 }
 
-void PathIntegrator::renderPass(std::uint32_t sampleIndex) {
-  for (std::uint64_t start = 0; start < m_pixels; start += m_capacity) {
-    std::uint32_t count = static_cast<std::uint32_t>(std::min<std::uint64_t>(m_capacity, m_pixels - start));
+void PathIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples) {
+  samples = std::max(1u, samples);
+  const std::uint64_t paths = m_pixels * samples;
+  if (paths > 0xffffffffull) throw Error("a pass of " + std::to_string(samples) + " samples per pixel has too many paths");
+  for (std::uint64_t start = 0; start < paths; start += m_capacity) {
+    std::uint32_t count = static_cast<std::uint32_t>(std::min<std::uint64_t>(m_capacity, paths - start));
     Globals& g = m_globals.host();
-    g.chunkFirstPixel = static_cast<std::uint32_t>(start);
-    g.chunkPixels = count;
+    g.chunkFirst = static_cast<std::uint32_t>(start);
+    g.chunkPaths = count;
     g.sampleIndex = sampleIndex;
+    g.passSamples = samples;
     m_globals.upload();
 
     VK_CHECK(vkResetCommandBuffer(m_cmd, 0));
@@ -254,7 +279,8 @@ void PathIntegrator::renderPass(std::uint32_t sampleIndex) {
     // Fold the 32-bit device counters into 64-bit totals and restart them.
     std::uint32_t* s = static_cast<std::uint32_t*>(m_stats->mapped);
     m_totals.addDevice(s);
-    std::memset(s, 0, STAT_COUNT * 4);
+    for (std::uint32_t b = 0; b < STAT_BOUNCE_SLOTS; ++b) m_raysPerBounce[b] += s[STAT_PER_BOUNCE + b];
+    std::memset(s, 0, STAT_BUFFER_UINTS * 4);
   }
 }
 

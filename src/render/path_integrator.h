@@ -16,29 +16,36 @@ namespace nusselt {
 class PathIntegrator : public Integrator {
  public:
   // slotKeys: the material table's shade slots (one specialised shade pipeline each).
-  // pixels: the film's size; paths are traced in chunks of at most `capacity` pixels.
+  // pixels: the film's size; a pass of at most `samplesPerPass` samples per pixel traces
+  // pixels x samples paths in chunks of at most `capacity`.
   PathIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
-                 const std::vector<std::vector<std::uint32_t>>& slotKeys, std::uint64_t pixels);
+                 const std::vector<std::vector<std::uint32_t>>& slotKeys, std::uint64_t pixels,
+                 std::uint32_t samplesPerPass, const std::vector<std::string>& slotNames);
   ~PathIntegrator() override;
 
-  // Paths traced together in one chunk of a pass for this render (one indirect dispatch covers a
-  // whole queue: its group count must stay <= 65535).
-  static std::uint32_t capacityFor(const RenderSettings& settings, std::uint64_t pixels);
+  // Paths traced together in one chunk of a pass of `samples` samples per pixel (one indirect
+  // dispatch covers a whole queue: its group count must stay <= 65535).
+  static std::uint32_t capacityFor(const RenderSettings& settings, std::uint64_t pixels, std::uint32_t samples);
+  // The samples per pass a render uses: settings.samplesPerPass, or when 0 enough to put about
+  // 2^18 paths in flight on a CPU device and 2^21 on a GPU, at most 64 and at most spp; never so
+  // many that pixels x samples overflows 32 bits.
+  static std::uint32_t samplesPerPassFor(const RenderSettings& settings, std::uint64_t pixels, bool cpuDevice);
   // Device bytes of the path state and queues.
   static std::uint64_t bytesFor(std::uint32_t capacity, std::size_t slots);
 
-  void renderPass(std::uint32_t sampleIndex) override;
+  void renderPass(std::uint32_t sampleIndex, std::uint32_t samples) override;
   RenderStats stats() const override { return m_totals; }
   void addStats(const RenderStats& carried) override;
   const std::vector<std::pair<std::string, double>>& stageSeconds() const override { return m_stageSeconds; }
   std::uint64_t deviceBytes() const override;
+  const std::vector<std::uint64_t>& raysPerBounce() const override { return m_raysPerBounce; }
   double pipelineSeconds() const { return m_pipelineSeconds; }
 
  private:
   void createPipelines();
   void recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount);
   void dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst, std::uint32_t zeroCount,
-                      std::uint32_t argsFirst, std::uint32_t argsCount);
+                      std::uint32_t argsFirst, std::uint32_t argsCount, std::uint32_t bounce = 0);
   void mark(VkCommandBuffer cmd, const char* stage);
 
   vk::Context& m_ctx;
@@ -63,6 +70,8 @@ class PathIntegrator : public Integrator {
   std::uint32_t m_queryCapacity = 0;
   std::vector<const char*> m_marks;  // stage name of each timestamp after the first
   std::vector<std::pair<std::string, double>> m_stageSeconds;
+  std::vector<std::string> m_shadeMarks;        // "shade <model>" per slot (timing marks)
+  std::vector<std::uint64_t> m_raysPerBounce;  // STAT_BOUNCE_SLOTS totals
 };
 
 }  // namespace nusselt

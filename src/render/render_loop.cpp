@@ -41,7 +41,7 @@ bool RenderLoop::step() {
   if (m_renderer.samplesDone() >= m_options.spp || g_stopSignal != 0) return false;
   if (m_options.timeBudget > 0 && seconds() >= m_options.timeBudget) return false;
   try {
-    m_renderer.renderPass();
+    m_renderer.renderPass(m_options.spp - m_renderer.samplesDone());
   } catch (const Error& e) {
     // The device was lost or ran out of memory mid-render: its film cannot be read any more.
     const std::string saved =

@@ -62,7 +62,9 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   {
     std::size_t lightBound = scene.lights.size();
     for (std::uint32_t m : scene.triangleMaterial) lightBound += scene.materials[m].emits() ? 1 : 0;
-    const std::uint32_t capacity = PathIntegrator::capacityFor(settings, pixels);
+    m_samplesPerPass = PathIntegrator::samplesPerPassFor(
+        settings, pixels, m_ctx.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
+    const std::uint32_t capacity = PathIntegrator::capacityFor(settings, pixels, m_samplesPerPass);
     const std::uint64_t need = DeviceScene::bytesFor(scene.triangleCount(), lightBound,
                                                      m_settings.traversal == Traversal::RayQuery) +
                                std::max<std::size_t>(scene.materials.size(), 1) * sizeof(shared::GpuMaterial) +
@@ -115,7 +117,8 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   m_camera = scene.hasCamera ? scene.camera : frameScene(scene);
   writeCamera(m_camera);
 
-  auto integrator = std::make_unique<PathIntegrator>(m_ctx, *m_globals, m_settings, m_materials->slotKeys(), pixels);
+  auto integrator = std::make_unique<PathIntegrator>(m_ctx, *m_globals, m_settings, m_materials->slotKeys(), pixels,
+                                                     m_samplesPerPass, m_materials->slotNames());
   m_summary.pipelineSeconds = integrator->pipelineSeconds();
   m_integrator = std::move(integrator);
   m_globals->upload();
@@ -132,13 +135,18 @@ Renderer::~Renderer() {
   m_globals.reset();
 }
 
-void Renderer::renderPass() {
+void Renderer::renderPass(std::uint32_t samples) {
   // Fault injection for the tests of device loss (no GPU can be lost on purpose):
   // NUSSELT_FAULT_DEVICE_LOST_AFTER=N makes the pass after N samples fail as a lost device would.
   static const char* fault = std::getenv("NUSSELT_FAULT_DEVICE_LOST_AFTER");
   if (fault && m_samples >= std::strtoul(fault, nullptr, 10)) VK_CHECK(VK_ERROR_DEVICE_LOST);
-  m_integrator->renderPass(m_settings.sampleOffset + m_samples);
-  ++m_samples;
+  samples = samples == 0 ? m_samplesPerPass : std::min(samples, m_samplesPerPass);
+  m_integrator->renderPass(m_settings.sampleOffset + m_samples, samples);
+  m_samples += samples;
+}
+
+void Renderer::render(std::uint32_t spp) {
+  while (m_samples < spp) renderPass(spp - m_samples);
 }
 
 void Renderer::restoreAccumulation(const Image& saved, std::uint32_t spp) {

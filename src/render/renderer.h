@@ -57,9 +57,15 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Traces one more sample per pixel (sample index = sampleOffset + samplesDone()).
-  void renderPass();
+  // Traces one pass: `samples` more samples per pixel (0: samplesPerPass(); never more than
+  // samplesPerPass()), sample indices from sampleOffset + samplesDone(). The image does not depend
+  // on how samples are grouped into passes.
+  void renderPass(std::uint32_t samples = 0);
+  // Passes until samplesDone() reaches spp.
+  void render(std::uint32_t spp);
   std::uint32_t samplesDone() const { return m_samples; }
+  // The samples per pixel of a full pass (RenderSettings::samplesPerPass, or chosen for the device).
+  std::uint32_t samplesPerPass() const { return m_samplesPerPass; }
   // The current estimate: film sum / samples; variance of the mean when withVariance. The raw
   // sums (Image::sum, Image::sumSq) are always included, for resuming and merging.
   Image image(bool withVariance = false) { return m_film->download(withVariance); }
@@ -70,9 +76,12 @@ class Renderer {
   // Adds counts carried over from a resumed render to the statistics.
   void addStats(const RenderStats& carried) { m_integrator->addStats(carried); }
   RenderStats stats() const { return m_integrator->stats(); }
-  // GPU time per stage name (camera, submit, intersect, shade, shadow, accumulate) summed over
+  // GPU time per stage name (camera, submit, intersect, "shade <model>" per shade pipeline, shadow,
+  // accumulate) summed over
   // all passes so far; empty unless RenderSettings::timeStages.
   const std::vector<std::pair<std::string, double>>& stageSeconds() const { return m_integrator->stageSeconds(); }
+  // Extension rays per bounce over all passes so far (Integrator::raysPerBounce).
+  const std::vector<std::uint64_t>& raysPerBounce() const { return m_integrator->raysPerBounce(); }
   const SceneSummary& summary() const { return m_summary; }
   const RenderSettings& settings() const { return m_settings; }
 
@@ -99,6 +108,7 @@ class Renderer {
   RenderSettings m_settings;
   SceneSummary m_summary;
   std::uint32_t m_samples = 0;
+  std::uint32_t m_samplesPerPass = 1;
   Camera m_camera;
   std::unique_ptr<StageGlobals> m_globals;
   std::unique_ptr<DeviceScene> m_scene;

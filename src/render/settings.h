@@ -130,7 +130,12 @@ struct RenderSettings {
   std::uint32_t sampleOffset = 0;
   // Time every stage with GPU timestamps (stageSeconds()); for benchmarks.
   bool timeStages = false;
-  // Paths traced together in one chunk of a pass (path state memory ~128 bytes each).
+  // Samples per pixel traced together in one pass (`--samples-per-pass`); 0 = automatic
+  // (samplesPerPassFor). A pass of K samples gives the image of K passes of one sample bit for
+  // bit: it only puts more paths in flight per dispatch, which keeps a CPU device's cores busy
+  // through the short tail of each bounce and a GPU's many more cores fed.
+  std::uint32_t samplesPerPass = 0;
+  // Paths traced together in one chunk of a pass (path state memory ~150 bytes each).
   std::uint32_t maxPathsPerChunk = 1u << 20;
 };
 

@@ -48,6 +48,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "brdf/merl.h"
 #include "io/image_decode.h"
 #include "scene/gltf_compression.h"
 #include "scene/tangents.h"
@@ -1091,8 +1092,7 @@ class Converter {
     if (brdf != gm.extensions.end()) {
       const std::string context = name_ + ": " + field + " NUSSELT_brdf";
       const tinygltf::Value& v = brdf->second;
-      std::string known;
-      for (const ModelSpec& s : allModels()) known += (known.empty() ? "" : ", ") + s.name;
+      const std::string known = knownModelNames();
       if (!v.IsObject())
         throw Error(context + ": must be an object {\"model\": ..., \"params\": {...}} or {\"components\": [...]}");
       // One model and its parameters: {"model": name, "params": {...}} (the object `where` names).
@@ -1102,6 +1102,22 @@ class Converter {
         const std::string modelName = o.Get("model").Get<std::string>();
         const ModelSpec* spec = findModel(modelName);
         if (!spec) throw Error(where + ": unknown model " + quoted(modelName) + " (known models: " + known + ")");
+        if (spec->measured) {
+          // A measured table: {"model": "merl", "file": "name.binary"}, the path relative to the
+          // scene file and inside its folder, as buffers and images (docs/measured.md).
+          if (o.Has("params")) throw Error(where + ": model " + quoted(modelName) + " has no \"params\" (it reads \"file\")");
+          if (!o.Has("file") || !o.Get("file").IsString())
+            throw Error(where + ".file: model " + quoted(modelName) + " needs \"file\", a MERL binary file relative to the scene");
+          const std::string file = o.Get("file").Get<std::string>();
+          const std::string path = vetUri(file, where + ".file", box_);
+          BrdfParams p = loadMerl(path, where + ".file " + quoted(file));
+          const MerlTable& t = merlTable(p);
+          if (t.unmeasured)
+            warnOnce(file + ": " + str(std::uint64_t(t.unmeasured)) + " of " + str(std::uint64_t(MERL_NODES)) +
+                     " table nodes not measured (negative), filled from the nearest measured node (docs/measured.md)");
+          return {spec, p};
+        }
+        if (o.Has("file")) throw Error(where + ".file: only measured models (merl) read a file");
         NamedParams params;
         if (o.Has("params")) {
           const tinygltf::Value& p = o.Get("params");
@@ -1127,8 +1143,8 @@ class Converter {
           const tinygltf::Value& c = list.Get(int(k));
           if (!c.IsObject()) throw Error(where + ": must be an object {\"model\": ..., \"weight\": ..., \"params\": {...}}");
           for (const std::string& key : c.Keys())
-            if (key != "model" && key != "weight" && key != "params")
-              throw Error(where + ": unknown field " + quoted(key) + " (expected model, weight, params)");
+            if (key != "model" && key != "weight" && key != "params" && key != "file")
+              throw Error(where + ": unknown field " + quoted(key) + " (expected model, weight, params, file)");
           MaterialComponent mc;
           if (c.Has("weight")) {
             const tinygltf::Value& w = c.Get("weight");

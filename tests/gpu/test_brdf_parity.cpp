@@ -65,7 +65,8 @@ TEST(BrdfParity, CpuAndGpuEvaluateTheSameFunction) {
   struct Push {
     std::uint64_t pairs, params, result;
     std::uint32_t count, pad;
-  } push{pairBuf.address, paramBuf.address, resultBuf.address, std::uint32_t(n), 0};
+    std::uint64_t measured;  // merl's tables (tests/gpu/test_merl_gpu.cpp); none here
+  } push{pairBuf.address, paramBuf.address, resultBuf.address, std::uint32_t(n), 0, 0};
 
   // Tolerance: the two builds round differently (fused multiply-adds, LLVM's vs glibc's exp, pow,
   // sin...), by a few ulps per operation; what that does to f depends on how sensitive f is at

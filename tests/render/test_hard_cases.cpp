@@ -320,7 +320,7 @@ TEST(HardCases, CameraInsideGeometry) {
   Renderer renderer(test::context(), s, settings);
   RenderStats before = renderer.stats();
   auto next = [&] {
-    for (std::uint32_t i = 0; i < settings.spp; ++i) renderer.renderPass();
+    renderer.render(renderer.samplesDone() + settings.spp);
     test::Rendered r{renderer.image(true), renderer.stats(), renderer.summary()};
     r.stats.nonFiniteSamples -= before.nonFiniteSamples;
     r.stats.samplerBoundViolations -= before.samplerBoundViolations;
@@ -560,7 +560,7 @@ TEST_P(HardSetsOfTheCatalogue, GrazingViewAndLights) {
     SCOPED_TRACE(lightingModeName(mode));
     const auto r0 = std::chrono::steady_clock::now();
     renderer.setLighting(mode);
-    for (std::uint32_t i = 0; i < settings.spp; ++i) renderer.renderPass();
+    renderer.render(renderer.samplesDone() + settings.spp);
     test::Rendered r{renderer.image(true), renderer.stats(), summary};
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - r0).count();
     // This mode's counts: the renderer's statistics accumulate over the three.

@@ -75,7 +75,7 @@ Rendered render(const Scene& scene, const RenderSettings& settings) {
   if (forced && *forced && s.traversal == Traversal::Auto && !parseTraversal(forced, s.traversal))
     throw Error(std::string("NUSSELT_TEST_TRAVERSAL=") + forced + ": not auto, rayquery or bvh");
   Renderer r(context(), scene, s);
-  for (std::uint32_t i = 0; i < s.spp; ++i) r.renderPass();
+  r.render(s.spp);
   return {r.image(true), r.stats(), r.summary()};
 }
 

@@ -24,6 +24,7 @@
 #include "mirror.h"
 #include "dielectric.h"
 #include "gltf_pbr.h"
+#include "merl.h"
 SHARED_BEGIN
 
 // Model ids: stable numbers, also written into cache keys and EXR headers.
@@ -47,7 +48,8 @@ SHARED_BEGIN
 #define MODEL_MIRROR 17u
 #define MODEL_DIELECTRIC 18u
 #define MODEL_GLTF_PBR 19u
-#define MODEL_COUNT 20u
+#define MODEL_MERL 20u  // measured (a table per material: docs/measured.md)
+#define MODEL_COUNT 21u
 
 // Delta models (mirror, dielectric) are never evaluated or light-sampled: sample them
 // analytically (mirrorReflectance, dielectricReflectance / dielectricRefract).
@@ -77,6 +79,7 @@ SHARED_FN vec3 brdfEval(uint model, BrdfParams p, vec3 wi, vec3 wo) {
     case MODEL_MIRROR: return mirrorEval(p, wi, wo);
     case MODEL_DIELECTRIC: return dielectricEval(p, wi, wo);
     case MODEL_GLTF_PBR: return gltfPbrEval(p, wi, wo);
+    case MODEL_MERL: return merlEval(p, wi, wo);
     default: break;
   }
   return vec3(0.0f);
