@@ -446,7 +446,8 @@ int benchRenderCommand(const BenchArgs& a) {
     if (a.repeats > 1)
       for (std::size_t k = 0; k < traversals.size(); ++k) {
         const std::vector<BenchRun>& rs = runs[k];
-        std::printf("  %s, median [min-max] of %u: %s samples/s, %s Mrays/s, %s CPU cores, setup %s s, warm-up %s s\n",
+        std::printf("  %s, %s, median [min-max] of %u: %s samples/s, %s Mrays/s, %s CPU cores, setup %s s, warm-up %s s\n",
+                    path.empty() ? "default (cornell-box)" : std::filesystem::path(path).filename().c_str(),
                     traversalName(resolveTraversal(ctx, traversals[k])), a.repeats,
                     medianRange(rs, [](auto& r) { return r.samplesPerSecond; }, "%.0f").c_str(),
                     medianRange(rs, [](auto& r) { return r.mraysPerSecond; }, "%.3f").c_str(),

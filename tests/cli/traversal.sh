@@ -53,7 +53,7 @@ NUSSELT_FAULT_NO_RAY_QUERY=1 "$nusselt" devices | grep -q "no ray queries" || fa
 
 "$nusselt" bench render --spp 1 --width 16 --height 16 --traversal bvh,auto --repeats 2 "" >"$work/bench" 2>&1 ||
   fail "bench render exit $?: $(cat "$work/bench")"
-grep -q "bvh, median \[min-max\] of 2" "$work/bench" || fail "bench render: no medians: $(cat "$work/bench")"
+grep -q "(cornell-box), bvh, median \[min-max\] of 2" "$work/bench" || fail "bench render: no medians: $(cat "$work/bench")"
 
 [ $fails -eq 0 ] && echo "traversal checks pass"
 exit $((fails > 0))
