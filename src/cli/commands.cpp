@@ -53,6 +53,7 @@ struct RenderArgs {
   double checkpointSeconds = 120;
   double timeBudget = 0;
   bool sppGiven = false;
+  EnvironmentArgs env;
 };
 
 int renderCommand(const RenderArgs& a) {
@@ -67,6 +68,7 @@ int renderCommand(const RenderArgs& a) {
 
   Scene scene = loadSceneOrDefault(a.scene, a.camera);
   printSceneWarnings(scene, a.quiet);
+  applyEnvironmentOptions(scene, a.env, a.quiet);
 
   RenderSettings s;
   s.seed = a.seed;
@@ -90,6 +92,7 @@ int renderCommand(const RenderArgs& a) {
   base.settings = s;
   base.camera = scene.hasCamera ? scene.camera : frameScene(scene);
   base.droppedTriangles = scene.droppedTriangles;
+  recordEnvironment(base, scene);
 
   // --resume: the saved render must be of this very render (scene and settings), fewer spp.
   Image saved;
@@ -147,6 +150,9 @@ int renderCommand(const RenderArgs& a) {
       std::fprintf(stderr, "scene: %s: %zu triangles, %zu materials (models: %s), %zu lights; BVH %u nodes in %.3f s\n",
                    scene.sourcePath.c_str(), sum.triangles, sum.materials, models.c_str(), sum.lights, sum.bvhNodes,
                    sum.bvhSeconds);
+      if (base.environment != "none")
+        std::fprintf(stderr, "environment: %s, scale %g, rotated %g degrees about +Y\n", base.environment.c_str(),
+                     base.envScale, base.envRotate);
       if (sum.samplerTrees && s.sampler == SamplerKind::Tabulated)
         std::fprintf(stderr, "sampler: %u tabulated tables (%.1f MiB) in %.2f s\n", sum.samplerTrees,
                      sum.samplerBytes / 1048576.0, sum.samplerSeconds);
@@ -494,6 +500,7 @@ int runCli(int argc, char** argv) {
   render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
   render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
   render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");
+  addEnvironmentOptions(*render, ra.env);
 
   CLI::App* devices = app.add_subcommand("devices", "List the Vulkan devices and whether nusselt can use them");
 
