@@ -67,8 +67,10 @@ EnvironmentImage readExrMap(const std::string& path) {
   out.width = image.width;
   out.height = image.height;
   out.rgb = std::move(image.rgb);
+  checkTexels(out, path);  // bad input texels first: the conversion below must not spread them
   // chromaticities: convert the file's RGB to Rec. 709 through XYZ (no chromatic adaptation: the
-  // attribute's white point is kept, as Mitsuba 3 and OpenEXR's own RGBtoXYZ do).
+  // attribute's white point is kept, as Mitsuba 3 and OpenEXR's own RGBtoXYZ do). Colours outside
+  // the Rec. 709 gamut get negative channels, which are clipped to 0 and counted.
   try {
     Imf::InputFile file(path.c_str());
     if (Imf::hasChromaticities(file.header())) {
@@ -79,12 +81,24 @@ EnvironmentImage readExrMap(const std::string& path) {
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) identity = identity && std::fabs(m[i][j] - (i == j ? 1.0f : 0.0f)) < 1e-5f;
       if (!identity) {
+        std::uint64_t clipped = 0;
         for (std::size_t k = 0; k + 2 < out.rgb.size(); k += 3) {
           const float r = out.rgb[k], g = out.rgb[k + 1], b = out.rgb[k + 2];
+          bool clip = false;
           // Imath matrices multiply row vectors: out = (r, g, b) M.
-          for (int c = 0; c < 3; ++c) out.rgb[k + c] = r * m[0][c] + g * m[1][c] + b * m[2][c];
+          for (int c = 0; c < 3; ++c) {
+            float v = r * m[0][c] + g * m[1][c] + b * m[2][c];
+            if (!(v >= 0.0f)) {
+              clip = true;
+              v = 0.0f;
+            }
+            out.rgb[k + c] = v;
+          }
+          clipped += clip ? 1 : 0;
         }
-        out.warnings.push_back("environment map '" + path + "': converted from its chromaticities to Rec. 709 primaries");
+        if (clipped)
+          out.warnings.push_back("environment map '" + path + "': " + std::to_string(clipped) + " texels lie outside "
+                                 "the Rec. 709 gamut; their negative channels were set to 0");
       }
     }
   } catch (const std::exception& e) {
@@ -308,10 +322,10 @@ EnvironmentImage readEnvironmentMap(const std::string& path) {
     in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size()));
     if (std::size_t(in.gcount()) != bytes.size()) throw mapError(path, "read error");
     img = decodeRadianceHdr(bytes.data(), bytes.size(), path);
+    checkTexels(img, path);
   } else {
     throw mapError(path, "unknown format (an equirectangular map must be OpenEXR or Radiance RGBE .hdr)");
   }
-  checkTexels(img, path);
   return img;
 }
 
