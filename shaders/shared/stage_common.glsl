@@ -13,6 +13,11 @@
 
 layout(local_size_x = WORKGROUP_SIZE) in;
 
+// The shade stages of a scene without an environment compile its light-sampling branch out: a
+// render builds only what its scene needs (lavapipe's Mesa 22.3 ran every branch body a subgroup
+// reached, taken or not; reference/lavapipe.md). Constant 7: after the shade stages' own 0..6.
+layout(constant_id = 7) const bool HAS_ENVIRONMENT = true;
+
 // ---- Queues ---------------------------------------------------------------------------------
 
 uint queueCount(uint queue) { return g.queues.v[queue]; }
@@ -133,7 +138,7 @@ bool sampleLight(vec3 x, float uSelect, vec2 uPoint, out LightSample ls) {
     ls.dist = dist;
     return ls.pdf > 0.0f && isFinite(ls.pdf);
   }
-  if (type == LIGHT_ENVIRONMENT) {
+  if (HAS_ENVIRONMENT && type == LIGHT_ENVIRONMENT) {
     // The environment map, importance-sampled (shaders/shared/envmap.h); shadow rays go to infinity.
     GpuEnvironment E = g.environment.v[0];
     float pdf;

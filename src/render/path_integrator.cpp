@@ -134,6 +134,10 @@ void PathIntegrator::createPipelines() {
             spec.push_back(key[0]);
             for (std::uint32_t k = 0; k < MAX_COMPONENTS; ++k) spec.push_back(k < key[0] ? key[1 + k] : key[1]);
           }
+          // Constant 7 (stage_common.glsl): HAS_ENVIRONMENT; ids 2..6 that a single-model module
+          // lacks are ignored by Vulkan.
+          spec.resize(7, 0u);
+          spec.push_back(m_hasEscape ? 1u : 0u);
           // One module per strategy (CMakeLists.txt): shade_sN / shade_combined_sN.
           const std::string module = std::string(key[0] > 0 ? "shade_combined" : "shade") + "_s" + std::to_string(sampler);
           m_shade[s] = vk::createComputePipeline(m_ctx, layout, module, spec);
