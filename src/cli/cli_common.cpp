@@ -64,8 +64,11 @@ void addEnvironmentOptions(CLI::App& app, EnvironmentArgs& a) {
 }
 
 void applyEnvironmentOptions(Scene& scene, const EnvironmentArgs& a, bool quiet) {
-  if (!std::isfinite(a.scale) || a.scale < 0.0f)
-    throw Error("--env-scale " + std::to_string(a.scale) + ": must be a finite number >= 0");
+  if (!std::isfinite(a.scale) || a.scale < 0.0f) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%g", double(a.scale));
+    throw Error(std::string("--env-scale ") + buf + ": must be a finite number >= 0");
+  }
   if (!std::isfinite(a.rotate)) throw Error("--env-rotate: must be a finite number of degrees");
   if (!a.env.empty() && !a.color.empty())
     throw Error("--env " + a.env + " and --env-color " + a.color + ": give one environment, not both");

@@ -39,6 +39,14 @@ bool parseCamera(const std::string& text, Camera& c) {
 
 }  // namespace
 
+namespace {
+std::string number(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+}  // namespace
+
 std::string describeEnvironment(const Scene& scene) {
   const Environment e = effectiveEnvironment(scene);
   if (e.kind == EnvironmentKind::Map) return "map " + e.path;
@@ -169,8 +177,8 @@ std::string firstDifference(const RenderRecord& a, const RenderRecord& b) {
         differ("the roulette (--roulette)", rouletteModeName(s.roulette), rouletteModeName(t.roulette)),
         differ("the camera", cameraText(a.camera), cameraText(b.camera)),
         differ("the environment (--env, --env-color)", a.environment, b.environment),
-        differ("the environment scale (--env-scale)", std::to_string(a.envScale), std::to_string(b.envScale)),
-        differ("the environment rotation (--env-rotate)", std::to_string(a.envRotate), std::to_string(b.envRotate))})
+        differ("the environment scale (--env-scale)", number(a.envScale), number(b.envScale)),
+        differ("the environment rotation (--env-rotate)", number(a.envRotate), number(b.envRotate))})
     if (!d.empty()) return d;
   return {};
 }
