@@ -61,6 +61,9 @@ void addEnvironmentOptions(CLI::App& app, EnvironmentArgs& a) {
   app.add_option("--env-scale", a.scale, "Multiplies the environment's radiance")->capture_default_str();
   app.add_option("--env-rotate", a.rotate, "Rotates the environment about +Y by this many degrees (counter-clockwise "
                                            "seen from above)")->capture_default_str();
+  app.add_option("--env-select", a.select, "How light sampling picks the environment in a scene with other lights: "
+                                           "half (half of the samples) or power (by estimated power)")
+      ->capture_default_str()->check(CLI::IsMember({"half", "power"}));
 }
 
 void applyEnvironmentOptions(Scene& scene, const EnvironmentArgs& a, bool quiet) {
@@ -114,6 +117,7 @@ void applyEnvironmentOptions(Scene& scene, const EnvironmentArgs& a, bool quiet)
   }
   e.scale = a.scale;
   e.rotateDegrees = a.rotate;
+  e.selectByPower = a.select == "power";
   scene.environment = std::move(e);
 }
 

@@ -32,6 +32,7 @@ struct EnvironmentArgs {
   std::string color;     // --env-color R,G,B; empty: not given
   float scale = 1.0f;    // --env-scale
   float rotate = 0.0f;   // --env-rotate, degrees about +Y
+  std::string select = "half";  // --env-select: half or power
 };
 // Registers --env, --env-color, --env-scale and --env-rotate on a subcommand.
 void addEnvironmentOptions(CLI::App& app, EnvironmentArgs& args);

@@ -282,6 +282,7 @@ struct BenchArgs {
   std::uint32_t spp = 4;
   std::uint32_t width = 256, height = 256;
   int device = -1;
+  EnvironmentArgs env;
 };
 
 int benchRenderCommand(const BenchArgs& a) {
@@ -301,6 +302,7 @@ int benchRenderCommand(const BenchArgs& a) {
               "Mrays/s");
   for (const std::string& path : scenes) {
     Scene scene = loadSceneOrDefault(path, "");
+    applyEnvironmentOptions(scene, a.env, false);
     RenderSettings s;
     s.width = a.width;
     s.height = a.height;
@@ -514,6 +516,7 @@ int runCli(int argc, char** argv) {
   benchRender->add_option("--width", ba.width, "Image width")->capture_default_str()->check(CLI::Range(1u, 65536u));
   benchRender->add_option("--height", ba.height, "Image height")->capture_default_str()->check(CLI::Range(1u, 65536u));
   benchRender->add_option("--device", ba.device, "Vulkan device index");
+  addEnvironmentOptions(*benchRender, ba.env);
 
   AlbedoArgs aa;
   CLI::App* albedo = app.add_subcommand("albedo", "Directional albedo of a reflectance model (cosine-weighted integral of its "

@@ -108,10 +108,13 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene) : m_ctx(ctx), m_b
     weights.push_back(power);
   }
 
-  // ---- The environment: one light among the others, chosen with probability 1/2 when there are
-  // others (a fixed split: an environment's power has no common measure with a lamp's inside the
-  // scene; docs/environment.md measures the choice), always when alone ----
-  const EnvironmentData env = buildEnvironment(effectiveEnvironment(scene));
+  // ---- The environment: one light among the others, always chosen when alone. With others, by
+  // default with probability 1/2 (a fixed split: the power of an environment, which reaches only
+  // the parts of the scene that see the sky, compares badly with a lamp's); --env-select power:
+  // in proportion to its power through the scene's bounding disc, pi R^2 x integral of luminance
+  // over the sphere (pbrt-v4's ImageInfiniteLight::Phi). docs/environment.md measures both. ----
+  const Environment envDesc = effectiveEnvironment(scene);
+  const EnvironmentData env = buildEnvironment(envDesc);
   if (env.emits()) {
     double others = 0;
     for (double w : weights) others += w;
@@ -119,7 +122,8 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene) : m_ctx(ctx), m_b
     l.info = glm::uvec4(LIGHT_ENVIRONMENT, 0u, 0u, 0u);
     m_environmentLight = static_cast<std::uint32_t>(lights.size());
     lights.push_back(l);
-    weights.push_back(others > 0 ? others : 1.0);
+    const double power = M_PI * double(radius) * radius * env.luminanceIntegral;
+    weights.push_back(others <= 0 ? 1.0 : envDesc.selectByPower ? power : others);
   }
   m_lights = weights.size();
 

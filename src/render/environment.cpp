@@ -89,14 +89,14 @@ EnvironmentData buildEnvironment(const Environment& env) {
   }
   marginal[h] = 1.0f;
 
-  // ---- Power estimate for light selection: integral of luminance over the sphere (W/m^2 through
-  // a unit disc, per pi) from the texel luminances and their solid angles ----
+  // ---- Integral of luminance over the sphere (texel values times their solid angles), for the
+  // power estimate of light selection ----
   double integral = 0;
   for (int y = 0; y < h; ++y) {
     const double solid = (2.0 * M_PI / w) * (std::cos(M_PI * y / h) - std::cos(M_PI * (y + 1) / h));
     for (int x = 0; x < w; ++x) integral += lum[std::size_t(y) * w + x] * solid;
   }
-  d.power = integral;
+  d.luminanceIntegral = integral;
   return d;
 }
 

@@ -24,7 +24,7 @@ struct EnvironmentData {
   std::vector<glm::vec4> texels;         // width * height, radiance x scale
   std::vector<float> distribution;       // dist2dSize(width, height) floats
   double weightTotal = 0;                // sum of the texel weights (0: the map is black: no light)
-  double power = 0;                      // integral of luminance over the sphere [W/(m^2)] x pi R^2 / R^2
+  double luminanceIntegral = 0;          // integral of the texels' luminance over the sphere [W/m^2]
 
   bool emits() const { return weightTotal > 0; }
   // The CPU view for the shared functions (envRadiance, envPdf, envSample).

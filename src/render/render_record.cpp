@@ -63,6 +63,7 @@ void recordEnvironment(RenderRecord& r, const Scene& scene) {
   r.environment = describeEnvironment(scene);
   r.envScale = e.scale;
   r.envRotate = e.rotateDegrees;
+  r.envSelect = e.selectByPower ? "power" : "half";
 }
 
 ImageMetadata makeMetadata(const RenderRecord& r) {
@@ -81,7 +82,8 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
                   {"nusselt/components", componentSelectionName(r.settings.components)},
                   {"nusselt/models", r.models},
                   {"nusselt/camera", cameraText(r.camera)},
-                  {"nusselt/environment", r.environment}};
+                  {"nusselt/environment", r.environment},
+                  {"nusselt/envSelect", r.envSelect}};
   meta.ints = {{"nusselt/spp", r.spp},
                {"nusselt/sppOffset", r.settings.sampleOffset},
                {"nusselt/seed", r.settings.seed},
@@ -155,6 +157,7 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   r.environment = findString(meta, "nusselt/environment").value_or("none");
   r.envScale = findDouble(meta, "nusselt/envScale").value_or(1);
   r.envRotate = findDouble(meta, "nusselt/envRotate").value_or(0);
+  r.envSelect = findString(meta, "nusselt/envSelect").value_or("half");
   return r;
 }
 
@@ -178,7 +181,8 @@ std::string firstDifference(const RenderRecord& a, const RenderRecord& b) {
         differ("the camera", cameraText(a.camera), cameraText(b.camera)),
         differ("the environment (--env, --env-color)", a.environment, b.environment),
         differ("the environment scale (--env-scale)", number(a.envScale), number(b.envScale)),
-        differ("the environment rotation (--env-rotate)", number(a.envRotate), number(b.envRotate))})
+        differ("the environment rotation (--env-rotate)", number(a.envRotate), number(b.envRotate)),
+        differ("the environment's selection (--env-select)", a.envSelect, b.envSelect)})
     if (!d.empty()) return d;
   return {};
 }

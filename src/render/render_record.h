@@ -32,6 +32,7 @@ struct RenderRecord {
   // The environment (docs/environment.md): "none", "uniform R,G,B" or "map FILE" (describeEnvironment).
   std::string environment = "none";
   double envScale = 1, envRotate = 0;
+  std::string envSelect = "half";  // --env-select
 };
 
 // The record's description of an environment ("none", "uniform R,G,B", "map FILE"); a scene's

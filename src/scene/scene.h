@@ -139,6 +139,9 @@ struct Environment {
   glm::vec3 color{0.0f};        // Uniform: the radiance
   float scale = 1.0f;           // radiance multiplier (--env-scale)
   float rotateDegrees = 0.0f;   // rotation about +Y, counter-clockwise seen from above (--env-rotate)
+  // How light sampling chooses the environment when the scene has other lights (--env-select):
+  // false = half of the light samples (the default), true = in proportion to estimated power.
+  bool selectByPower = false;
 
   bool present() const { return kind != EnvironmentKind::None; }
 };
