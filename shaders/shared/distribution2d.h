@@ -14,7 +14,7 @@
 // Buffer access: GLSL passes a Floats buffer reference (layout.h), C++ a const float pointer.
 #ifndef NUSSELT_DISTRIBUTION2D_H
 #define NUSSELT_DISTRIBUTION2D_H
-#include "prelude.h"
+#include "layout.h"  // GLSL: the Floats buffer reference
 
 #ifdef __cplusplus
 SHARED_BEGIN

@@ -250,7 +250,7 @@ struct Globals {
   vec4 camUp;       // unit up * tan(yfov/2), or * ymag for orthographic
   vec4 camForward;  // unit view direction
   vec4 sceneSphere; // bounding sphere of the scene: centre, radius (directional lights)
-  vec4 background;  // radiance of rays that escape the scene (rgb)
+  vec4 background;  // Scene::background (rgb), for tools; the stages see it as a uniform environment
 
   BUFREF(BvhNodes) bvh;
   BUFREF(Triangles) triangles;
