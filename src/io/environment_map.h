@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "io/radiance_hdr.h"
+
 namespace nusselt {
 
 struct EnvironmentImage {
@@ -23,12 +25,5 @@ struct EnvironmentImage {
 // height are warnings, not errors.
 EnvironmentImage readEnvironmentMap(const std::string& path);
 
-// Decodes a Radiance RGBE (.hdr) file held in memory; `name` is used in messages. For tests and
-// the fuzzer; readEnvironmentMap calls it for .hdr files.
-EnvironmentImage decodeRadianceHdr(const std::uint8_t* data, std::size_t size, const std::string& name);
-
-// Encodes rgb (3 * width * height floats, top row first) as a flat (uncompressed) or run-length
-// encoded Radiance RGBE file in memory. For generated test maps and tools; not a general writer.
-std::vector<std::uint8_t> encodeRadianceHdr(const std::vector<float>& rgb, int width, int height, bool rle);
 
 }  // namespace nusselt

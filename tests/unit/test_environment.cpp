@@ -235,7 +235,7 @@ TEST(RadianceHdr, FlatAndRunLengthEncodedRoundTrips) {
     for (int c = 0; c < 3; ++c) rgb[3 * x + c] = 2.0f;
   for (bool rle : {false, true}) {
     std::vector<std::uint8_t> bytes = encodeRadianceHdr(rgb, w, h, rle);
-    EnvironmentImage img = decodeRadianceHdr(bytes.data(), bytes.size(), "test.hdr");
+    RgbeImage img = decodeRadianceHdr(bytes.data(), bytes.size(), "test.hdr");
     ASSERT_EQ(img.width, w);
     ASSERT_EQ(img.height, h);
     for (std::size_t p = 0; p < std::size_t(w) * h; ++p) {
@@ -253,7 +253,7 @@ TEST(RadianceHdr, OldStyleRunsExposureAndRefusals) {
   // Old-style run: one pixel then (1, 1, 1, 3) repeats it 3 times; EXPOSURE 2 halves values.
   std::string head = "#?RADIANCE\nEXPOSURE=2\n\n-Y 1 +X 4\n";
   std::string px = std::string("\x80\x40\x20\x81", 4) + std::string("\x01\x01\x01\x03", 4);
-  EnvironmentImage img = decode(head + px);
+  RgbeImage img = decode(head + px);
   ASSERT_EQ(img.width, 4);
   for (int x = 0; x < 4; ++x) EXPECT_NEAR(img.rgb[3 * x], (128.5f / 256.0f) * 2.0f / 2.0f, 1e-6f);
   // Refusals name the file and the problem.

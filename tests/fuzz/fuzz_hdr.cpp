@@ -1,0 +1,38 @@
+// fuzz_hdr.cpp: libFuzzer target for the Radiance RGBE decoder (io/radiance_hdr.h, issue 17).
+//
+// The bytes are an .hdr file, as `--env` would read it. nusselt::Error is the decoder's one
+// documented failure; any other exception, a crash, a leak, an ASan or UBSan report, or a decoded
+// image that breaks its contract (dimensions within the caps, 3 floats per texel, finite values
+// >= 0) is a finding.
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+
+#include "io/radiance_hdr.h"
+#include "util/error.h"
+
+namespace {
+
+[[noreturn]] void finding(const char* what) {
+  std::fprintf(stderr, "fuzz_hdr: %s\n", what);
+  std::abort();
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  try {
+    nusselt::RgbeImage image = nusselt::decodeRadianceHdr(data, size, "fuzz.hdr");
+    const std::int64_t texels = std::int64_t(image.width) * image.height;
+    if (image.width <= 0 || image.height <= 0) finding("empty image returned");
+    if (image.width > nusselt::kHdrMaxSide || image.height > nusselt::kHdrMaxSide || texels > nusselt::kHdrMaxTexels)
+      finding("image above the caps returned");
+    if (image.rgb.size() != std::size_t(3 * texels)) finding("RGB buffer size disagrees with the dimensions");
+    for (float v : image.rgb)
+      if (!std::isfinite(v) || v < 0) finding("non-finite or negative texel decoded");
+  } catch (const nusselt::Error&) {
+    // The documented failure.
+  }
+  return 0;
+}
