@@ -22,12 +22,11 @@ Error mapError(const std::string& path, const std::string& reason) {
   return Error("environment map '" + path + "': " + reason);
 }
 
-void checkSize(const std::string& path, std::int64_t w, std::int64_t h) {
+void checkSize(const std::string& path, std::int64_t w, std::int64_t h, std::int64_t maxTexels) {
   if (w <= 0 || h <= 0) throw mapError(path, "empty image");
-  if (w > kHdrMaxSide || h > kHdrMaxSide || w * h > kHdrMaxTexels)
+  if (w > kHdrMaxSide || h > kHdrMaxSide || w * h > maxTexels)
     throw mapError(path, "image " + std::to_string(w) + "x" + std::to_string(h) + " is larger than supported (at most " +
-                             std::to_string(kHdrMaxSide) + " per side and " + std::to_string(kHdrMaxTexels) +
-                             " texels)");
+                             std::to_string(kHdrMaxSide) + " per side and " + std::to_string(maxTexels) + " texels)");
 }
 
 struct Reader {
@@ -66,7 +65,8 @@ inline void rgbeToFloat(const std::uint8_t* c, float* out) {
 
 }  // namespace
 
-RgbeImage decodeRadianceHdr(const std::uint8_t* data, std::size_t size, const std::string& name) {
+RgbeImage decodeRadianceHdr(const std::uint8_t* data, std::size_t size, const std::string& name,
+                            std::int64_t maxTexels) {
   Reader r{data, size, 0, name};
   // ---- Header: "#?RADIANCE" (or any "#?" program name), variables, an empty line ----
   std::string magic = r.line();
@@ -99,11 +99,12 @@ RgbeImage decodeRadianceHdr(const std::uint8_t* data, std::size_t size, const st
       std::strcmp(xs, "+X") != 0)
     throw mapError(name, "resolution line '" + res.substr(0, 60) + "' is not of the form '-Y height +X width' (other "
                          "orientations are not supported)");
-  checkSize(name, w, h);
+  checkSize(name, w, h, maxTexels);
   RgbeImage img;
   img.width = int(w);
   img.height = int(h);
-  img.rgb.assign(std::size_t(3) * w * h, 0.0f);
+  // Rows are added as they are decoded: a header that claims a huge image in a short file fails
+  // at its first missing byte, not after allocating the whole image.
   std::vector<std::uint8_t> scan(std::size_t(4) * w);
   const float inv = float(1.0 / exposure);
 
@@ -157,6 +158,7 @@ RgbeImage decodeRadianceHdr(const std::uint8_t* data, std::size_t size, const st
         }
       }
     }
+    img.rgb.resize(std::size_t(3) * w * (y + 1));
     float* row = &img.rgb[std::size_t(3) * w * y];
     for (long x = 0; x < w; ++x) {
       rgbeToFloat(&scan[4 * x], row + 3 * x);

@@ -19,9 +19,11 @@ struct RgbeImage {
 };
 
 // Decodes a Radiance RGBE file held in memory; `name` is used in messages. Throws nusselt::Error
-// naming it and the problem (no signature, unsupported FORMAT or orientation, too large,
-// truncated, runs that overflow a scanline, ...).
-RgbeImage decodeRadianceHdr(const std::uint8_t* data, std::size_t size, const std::string& name);
+// naming it and the problem (no signature, unsupported FORMAT or orientation, more than
+// kHdrMaxSide per side or maxTexels in all, truncated, runs that overflow a scanline, ...).
+// Memory grows with the rows actually decoded.
+RgbeImage decodeRadianceHdr(const std::uint8_t* data, std::size_t size, const std::string& name,
+                            std::int64_t maxTexels = kHdrMaxTexels);
 
 // Encodes rgb (3 * width * height floats, top row first) as a flat (uncompressed) or run-length
 // encoded Radiance RGBE file in memory. For generated test maps and tools; not a general writer.
