@@ -17,6 +17,7 @@
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
 #include <ImfStandardAttributes.h>
+#include <ImfTiledOutputFile.h>
 
 #include "io/environment_map.h"
 #include "io/image.h"
@@ -337,6 +338,42 @@ TEST(EnvironmentMapFile, ExrChromaticitiesAreConvertedToRec709) {
     EXPECT_NEAR(m.rgb[c], expected, 1.5e-3) << "channel " << c;
   }
   std::remove(path.c_str());
+}
+
+// Tiled files and the lossy DWA compressions read like scanline ZIP files (the OpenEXR library
+// decodes them): a 64 x 32 tiled map (16 x 16 tiles) with DWAB and with PIZ compression. PIZ is
+// lossless for float data; DWAB quantises (its default level keeps smooth data within ~1 %).
+TEST(EnvironmentMapFile, TiledDwaAndPizExrMapsRead) {
+  const int w = 64, h = 32;
+  std::vector<float> rgb(3 * w * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) rgb[3 * (y * w + x) + c] = 0.5f + 0.3f * std::sin(0.1f * x + c) + 0.01f * y;
+  for (Imf::Compression comp : {Imf::DWAB_COMPRESSION, Imf::PIZ_COMPRESSION}) {
+    const std::string path = tempPath("tiled.exr");
+    {
+      Imf::Header header(w, h);
+      header.compression() = comp;
+      header.setTileDescription(Imf::TileDescription(16, 16, Imf::ONE_LEVEL));
+      for (const char* n : {"R", "G", "B"}) header.channels().insert(n, Imf::Channel(Imf::FLOAT));
+      Imf::FrameBuffer fb;
+      for (int c = 0; c < 3; ++c)
+        fb.insert(c == 0 ? "R" : c == 1 ? "G" : "B",
+                  Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(rgb.data() + c), 12, 12 * std::size_t(w)));
+      Imf::TiledOutputFile out(path.c_str(), header);
+      out.setFrameBuffer(fb);
+      out.writeTiles(0, out.numXTiles() - 1, 0, out.numYTiles() - 1);
+    }
+    EnvironmentImage m = readEnvironmentMap(path);
+    ASSERT_EQ(m.width, w);
+    ASSERT_EQ(m.height, h);
+    double worst = 0;
+    for (std::size_t i = 0; i < rgb.size(); ++i) worst = std::max(worst, double(std::fabs(m.rgb[i] - rgb[i]) / rgb[i]));
+    std::printf("[ env exr ] tiled, compression %d: worst relative difference %.3g\n", int(comp), worst);
+    EXPECT_LT(worst, comp == Imf::PIZ_COMPRESSION ? 1e-7 : 0.02) << "compression " << int(comp);
+    EXPECT_TRUE(m.warnings.empty());
+    std::remove(path.c_str());
+  }
 }
 
 }  // namespace
