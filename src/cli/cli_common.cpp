@@ -106,7 +106,12 @@ void applyEnvironmentOptions(Scene& scene, const EnvironmentArgs& a, bool quiet)
   } else {
     bool lit = !scene.lights.empty() || scene.background != glm::vec3(0.0f) || scene.environment.present();
     for (std::uint32_t m : scene.triangleMaterial) lit = lit || scene.materials[m].emits();
-    if (lit) return;
+    if (lit) {
+      if (!quiet && (a.scale != 1.0f || a.rotate != 0.0f || a.select != "half"))
+        std::fprintf(stderr, "warning: --env-scale, --env-rotate and --env-select apply to an environment "
+                             "(--env or --env-color); this render has none\n");
+      return;
+    }
     if (!quiet)
       std::fprintf(stderr, "warning: %s has no light (no emissive material, no punctual light, no environment): "
                            "rendering it in a uniform white environment of radiance 1. Give --env FILE, --env-color "
