@@ -92,8 +92,18 @@ fi
 "$nusselt" render "$scene" --resume "$work/map.exr" --spp 4 --width 8 --height 4 -q --env "$work/ok.hdr" \
   --env-scale 2 --env-rotate 30 && echo "ok   resume with the same environment" || fail "resume with the same environment"
 
-# The preview takes the same options.
-if "$nusselt" preview --help | grep -q -- "--env-rotate"; then echo "ok   preview has --env-rotate"; else fail "preview lacks --env options"; fi
+# The preview takes the same options and accumulates the same film as `render` (under Xvfb, from
+# the xvfb package of tools/bootstrap.sh, as tests/cli/preview.sh).
+"$nusselt" render "$scene" -o "$work/r.exr" --spp 3 --width 16 --height 8 -q --env "$work/ok.hdr" --env-rotate 30 \
+  --env-scale 0.5 || fail "render for the preview comparison"
+if xvfb-run -a "$nusselt" preview "$scene" --width 16 --height 8 --max-spp 3 --frames 8 --exr "$work/p.exr" -q \
+     --env "$work/ok.hdr" --env-rotate 30 --env-scale 0.5 2>"$work/stderr" &&
+   "$nusselt" diff "$work/p.exr" "$work/r.exr" | grep -qE "max \|diff\| 0$" &&
+   "$nusselt" info "$work/p.exr" | grep -qF "nusselt/envRotate: 30"; then
+  echo "ok   preview with --env equals render"
+else
+  fail "preview with --env: $(cat "$work/stderr"; "$nusselt" diff "$work/p.exr" "$work/r.exr" 2>&1)"
+fi
 
 [ $fails -eq 0 ] && echo "all environment CLI checks passed" || echo "$fails failures"
 exit $((fails > 0))
