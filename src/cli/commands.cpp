@@ -57,6 +57,7 @@ struct RenderArgs {
   double checkpointSeconds = 120;
   double timeBudget = 0;
   bool sppGiven = false;
+  EnvironmentArgs env;
 };
 
 int renderCommand(const RenderArgs& a) {
@@ -71,6 +72,7 @@ int renderCommand(const RenderArgs& a) {
 
   Scene scene = loadSceneOrDefault(a.scene, a.camera);
   printSceneWarnings(scene, a.quiet);
+  applyEnvironmentOptions(scene, a.env, a.quiet);
 
   RenderSettings s;
   s.seed = a.seed;
@@ -96,6 +98,7 @@ int renderCommand(const RenderArgs& a) {
   base.settings = s;
   base.camera = scene.hasCamera ? scene.camera : frameScene(scene);
   base.droppedTriangles = scene.droppedTriangles;
+  recordEnvironment(base, scene);
 
   // --resume: the saved render must be of this very render (scene and settings), fewer spp.
   Image saved;
@@ -164,6 +167,9 @@ int renderCommand(const RenderArgs& a) {
         std::snprintf(structures, sizeof structures, "BVH %u nodes in %.3f s", sum.bvhNodes, sum.bvhSeconds);
       std::fprintf(stderr, "scene: %s: %zu triangles, %zu materials (models: %s), %zu lights; %s\n",
                    scene.sourcePath.c_str(), sum.triangles, sum.materials, models.c_str(), sum.lights, structures);
+      if (base.environment != "none")
+        std::fprintf(stderr, "environment: %s, scale %g, rotated %g degrees about +Y\n", base.environment.c_str(),
+                     base.envScale, base.envRotate);
       if (sum.samplerTrees && s.sampler == SamplerKind::Tabulated)
         std::fprintf(stderr, "sampler: %u tabulated tables (%.1f MiB) in %.2f s\n", sum.samplerTrees,
                      sum.samplerBytes / 1048576.0, sum.samplerSeconds);
@@ -304,6 +310,7 @@ struct BenchArgs {
   int device = -1;
   std::vector<std::string> traversals{"auto"};
   std::uint32_t repeats = 1;
+  EnvironmentArgs env;
 };
 
 double cpuSecondsUsed() {
@@ -439,6 +446,7 @@ int benchRenderCommand(const BenchArgs& a) {
               "spp/pass", "seconds", "samples/s", "Mrays/s", "CPU cores", "setup s", "warm-up s");
   for (const std::string& path : scenes) {
     Scene scene = loadSceneOrDefault(path, "");
+    applyEnvironmentOptions(scene, a.env, false);
     std::vector<std::vector<BenchRun>> runs(traversals.size());
     for (std::uint32_t rep = 0; rep < a.repeats; ++rep)
       for (std::size_t k = 0; k < traversals.size(); ++k)
@@ -634,6 +642,7 @@ int runCli(int argc, char** argv) {
   render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
   render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
   render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");
+  addEnvironmentOptions(*render, ra.env);
 
   CLI::App* devices = app.add_subcommand("devices", "List the Vulkan devices and whether nusselt can use them");
 
@@ -659,6 +668,7 @@ int runCli(int argc, char** argv) {
   benchRender->add_option("--repeats", ba.repeats, "Repeats of every scene and traversal; with more than one, the "
                                                    "medians and ranges are printed")
       ->capture_default_str()->check(CLI::Range(1u, 1000u));
+  addEnvironmentOptions(*benchRender, ba.env);
 
   AlbedoArgs aa;
   CLI::App* albedo = app.add_subcommand("albedo", "Directional albedo of a reflectance model (cosine-weighted integral of its "

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "../../shaders/shared/layout.h"
+#include "render/environment.h"
 #include "scene/bvh.h"
 #include "util/error.h"
 
@@ -128,6 +129,24 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene, TraversalStructur
     lights.push_back(l);
     weights.push_back(power);
   }
+
+  // ---- The environment: one light among the others, always chosen when alone. With others, by
+  // default with probability 1/2 (a fixed split: the power of an environment, which reaches only
+  // the parts of the scene that see the sky, compares badly with a lamp's); --env-select power:
+  // in proportion to its power through the scene's bounding disc, pi R^2 x integral of luminance
+  // over the sphere (pbrt-v4's ImageInfiniteLight::Phi). docs/environment.md measures both. ----
+  const Environment envDesc = effectiveEnvironment(scene);
+  const EnvironmentData env = buildEnvironment(envDesc);
+  if (env.emits()) {
+    double others = 0;
+    for (double w : weights) others += w;
+    GpuLight l{};
+    l.info = glm::uvec4(LIGHT_ENVIRONMENT, 0u, 0u, 0u);
+    m_environmentLight = static_cast<std::uint32_t>(lights.size());
+    lights.push_back(l);
+    const double power = M_PI * double(radius) * radius * env.luminanceIntegral;
+    weights.push_back(others <= 0 ? 1.0 : envDesc.selectByPower ? power : others);
+  }
   m_lights = weights.size();
 
   // ---- Light selection proportional to estimated power ----
@@ -161,6 +180,15 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene, TraversalStructur
   make(m_lightBuffer, lights.size() * sizeof(GpuLight), "light", lights.data());
   make(m_lightCdf, cdf.size() * sizeof(float), "light CDF", cdf.data());
 
+  if (env.emits()) {
+    make(m_envTexels, env.texels.size() * sizeof(glm::vec4), "environment texels", env.texels.data());
+    make(m_envDistribution, env.distribution.size() * sizeof(float), "environment distribution", env.distribution.data());
+    shared::GpuEnvironment e = env.gpu;
+    e.texels = m_envTexels.address;
+    e.distribution = m_envDistribution.address;
+    make(m_envStruct, sizeof e, "environment", &e);
+  }
+
   // ---- Acceleration structures: one bottom level over all triangles (the scene is flattened to
   // world space), one top-level instance of it. Primitive i is triangle i of g.triangles. ----
   if (structures.accelerationStructures && triCount > 0) {
@@ -188,11 +216,14 @@ DeviceScene::~DeviceScene() { release(); }
 void DeviceScene::release() {
   vk::destroyAccelerationStructure(m_ctx, m_tlas);
   vk::destroyAccelerationStructure(m_ctx, m_blas);
-  for (vk::Buffer* b : {&m_bvh, &m_tris, &m_shading, &m_lightBuffer, &m_lightCdf}) vk::destroyBuffer(m_ctx, *b);
+  for (vk::Buffer* b : {&m_bvh, &m_tris, &m_shading, &m_lightBuffer, &m_lightCdf, &m_envTexels, &m_envDistribution,
+                        &m_envStruct})
+    vk::destroyBuffer(m_ctx, *b);
 }
 
 std::uint64_t DeviceScene::deviceBytes() const {
-  return m_bvh.size + m_tris.size + m_shading.size + m_lightBuffer.size + m_lightCdf.size + accelerationBytes();
+  return m_bvh.size + m_tris.size + m_shading.size + m_lightBuffer.size + m_lightCdf.size + m_envTexels.size +
+         m_envDistribution.size + m_envStruct.size + accelerationBytes();
 }
 
 void DeviceScene::fillGlobals(shared::Globals& g) const {
@@ -204,6 +235,8 @@ void DeviceScene::fillGlobals(shared::Globals& g) const {
   g.sceneSphere = m_sphere;
   g.background = v4(m_background);
   g.lightCount = static_cast<std::uint32_t>(m_lights);
+  g.environmentLight = m_environmentLight;
+  g.environment = m_envStruct.buffer ? m_envStruct.address : 0;
   g.triangleCount = static_cast<std::uint32_t>(m_triangles);
   g.tlasLow = static_cast<std::uint32_t>(m_tlas.address);
   g.tlasHigh = static_cast<std::uint32_t>(m_tlas.address >> 32);

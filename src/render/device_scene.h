@@ -53,6 +53,8 @@ class DeviceScene {
   const vk::Buffer& triangleBuffer() const { return m_tris; }
   // Bounding sphere of the triangles (centre, radius; radius 1 without triangles).
   glm::vec4 boundingSphere() const { return m_sphere; }
+  // The scene has an environment that emits (a light, and an escape stage for missed rays).
+  bool hasEnvironment() const { return m_environmentLight != 0xffffffffu; }
 
  private:
   void release();  // destroys every buffer and structure (idempotent)
@@ -65,7 +67,9 @@ class DeviceScene {
   glm::vec4 m_sphere{0.0f, 0.0f, 0.0f, 1.0f};
   glm::vec3 m_background{0.0f};
   double m_accelSeconds = 0;
+  std::uint32_t m_environmentLight = 0xffffffffu;  // index in the light list, INVALID_INDEX: none
   vk::Buffer m_bvh, m_tris, m_shading, m_lightBuffer, m_lightCdf;
+  vk::Buffer m_envTexels, m_envDistribution, m_envStruct;  // empty without an environment
   vk::AccelerationStructure m_blas, m_tlas;
 };
 
