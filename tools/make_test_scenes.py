@@ -6,6 +6,12 @@
                  on purpose (the loader must drop them: 64 of 1024).
   mis.gltf       a floor under a large dim and a small bright emissive quad (MIS test).
   punctual.gltf  a floor lit by one point and one spot light (KHR_lights_punctual).
+  environment.gltf  no light at all (the environment tests add one): a Lambert sphere (rho 0.5) at
+                 x = -1.2 and a mirror sphere (silver-like complex index) at x = +1.2, radius 1,
+                 seen from +z by a camera looking along -z (the map's centre).
+  env_bench.gltf     the environment benchmark's scene: a Lambert floor, a Lambert sphere and a
+                 glossy metal sphere (glTF metallic-roughness, roughness 0.3); no light.
+  env_bench_area.gltf  the same lit by an emissive quad above it (the speed comparison).
   combined.gltf  combined materials (NUSSELT_brdf components) in a small coloured box under an
                  area light: lambert + phong + mirror, lambert + dielectric, a saturated lambert
                  + a white phong; for renders that exercise every combined-material code path.
@@ -222,6 +228,62 @@ def furnace():
     b.write("furnace.gltf")
 
 
+def uv_sphere(centre, radius, rows=24, cols=48):
+    """A closed UV sphere (outward normals and winding) as positions, normals, indices."""
+    positions, normals = [], []
+    for i in range(rows + 1):
+        theta = math.pi * i / rows
+        for j in range(cols + 1):
+            phi = 2 * math.pi * j / cols
+            n = [math.sin(theta) * math.cos(phi), math.cos(theta), math.sin(theta) * math.sin(phi)]
+            positions.append([centre[k] + radius * n[k] for k in range(3)])
+            normals.append(n)
+    indices = []
+    for i in range(rows):
+        for j in range(cols):
+            a, c = i * (cols + 1) + j, (i + 1) * (cols + 1) + j
+            for tri in ((a, a + 1, c), (a + 1, c + 1, c)):
+                p0, p1, p2 = (positions[k] for k in tri)
+                g = cross(sub(p1, p0), sub(p2, p0))
+                if dot(g, g) < 1e-20:
+                    continue  # pole triangles: zero area
+                mid = [(p0[k] + p1[k] + p2[k]) / 3 - centre[k] for k in range(3)]
+                if dot(g, mid) < 0:
+                    tri = (tri[0], tri[2], tri[1])
+                indices.extend(tri)
+    return positions, normals, indices
+
+
+def environment():
+    b = Builder()
+    diffuse = b.material("diffuse", 0.5)
+    b.use("NUSSELT_brdf")
+    b.doc["materials"].append({"name": "mirror", "extensions": {"NUSSELT_brdf": {
+        "model": "mirror", "params": {"eta": [0.155, 0.117, 0.138], "k": [4.83, 3.12, 2.15]}}}})
+    mirror = len(b.doc["materials"]) - 1
+    b.mesh("diffuse_sphere", *uv_sphere((-1.2, 0.0, 0.0), 1.0), diffuse)
+    b.mesh("mirror_sphere", *uv_sphere((1.2, 0.0, 0.0), 1.0), mirror)
+    b.camera("camera", (0.0, 0.0, 6.0), None, 0.7, 2.0)
+    b.write("environment.gltf")
+
+
+def env_bench(area):
+    b = Builder()
+    floor = b.material("floor", 0.6)
+    diffuse = b.material("diffuse", 0.5)
+    b.doc["materials"].append({"name": "glossy_metal", "pbrMetallicRoughness": {
+        "baseColorFactor": [0.95, 0.8, 0.6, 1.0], "metallicFactor": 1.0, "roughnessFactor": 0.3}})
+    glossy = len(b.doc["materials"]) - 1
+    b.quad("floor", [[-4, 0, -4], [-4, 0, 4], [4, 0, 4], [4, 0, -4]], floor)
+    b.mesh("diffuse_sphere", *uv_sphere((-1.1, 1.0, 0.0), 1.0), diffuse)
+    b.mesh("glossy_sphere", *uv_sphere((1.1, 1.0, 0.0), 1.0), glossy)
+    if area:
+        light = b.material("light", 0.0, emission=(1.0, 1.0, 1.0), strength=20.0)
+        b.quad("light", [[-0.5, 4, -0.5], [0.5, 4, -0.5], [0.5, 4, 0.5], [-0.5, 4, 0.5]], light)
+    b.camera("camera", (0.0, 2.2, 6.5), (0.0, 0.8, 0.0), 0.7, 1.5)
+    b.write("env_bench_area.gltf" if area else "env_bench.gltf")
+
+
 def mis():
     b = Builder()
     floor = b.material("floor", 0.5)
@@ -277,3 +339,6 @@ if __name__ == "__main__":
     mis()
     punctual()
     combined()
+    environment()
+    env_bench(False)
+    env_bench(True)

@@ -27,7 +27,10 @@ SHARED_BEGIN
 #define QUEUE_RAY0 0u
 #define QUEUE_RAY1 1u
 #define QUEUE_SHADOW 2u
-#define QUEUE_SHADE_BASE 3u
+// Rays that hit nothing, for the escape stage (environment radiance); filled only when the scene
+// has an environment (Globals.environmentLight != INVALID_INDEX).
+#define QUEUE_ESCAPE 3u
+#define QUEUE_SHADE_BASE 4u
 #define QUEUE_COUNT (QUEUE_SHADE_BASE + MAX_MODEL_SLOTS)
 
 // ---- Statistics counters (stats buffer, uint each) -----------------------------------------------
@@ -59,6 +62,7 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 #define LIGHT_POINT 1u
 #define LIGHT_SPOT 2u
 #define LIGHT_DIRECTIONAL 3u
+#define LIGHT_ENVIRONMENT 4u  // the environment (Globals.environment): at most one, importance-sampled
 
 // ---- Light-sampling modes (Globals.counts.w): MIS by default; the others exist for tests ----------
 #define LIGHTING_MIS 0u
@@ -207,6 +211,24 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer TabSets { T
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer TabTables { TabTable v[]; };
 #endif
 
+// The environment: an equirectangular (lat-long) radiance map and its sampling distribution
+// (shaders/shared/envmap.h: convention, lookup, pdf, sampling). info = (width, height, 0, 0);
+// rotation = (cos a, sin a, 0, 0) of the rotation by a about +Y (--env-rotate) from map to world;
+// texels: width * height radiances (rgb, the scale applied, w unused), row-major, row 0 = the top
+// (+Y); distribution: the piecewise-constant 2-D distribution over the map's texels
+// (shaders/shared/distribution2d.h), conditional CDFs then the marginal CDF.
+struct GpuEnvironment {
+  uvec4 info;
+  vec4 rotation;
+  vec4 reserved;
+  BUFREF(Vec4s) texels;
+  BUFREF(Floats) distribution;
+};
+STATIC_ASSERT_SIZE(GpuEnvironment, 64);
+#ifndef __cplusplus
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Environments { GpuEnvironment v[]; };
+#endif
+
 // Per-render constants and the addresses of every buffer (buffer device addresses: no storage
 // buffer binding limits the size of a scene; lavapipe caps one binding at 128 MiB).
 struct Globals {
@@ -229,12 +251,17 @@ struct Globals {
   uint componentChoice;  // COMPONENTS_*
   uint roulette;         // ROULETTE_*
   uint passSamples;      // samples per pixel in this pass (sample indices sampleIndex + 0 .. passSamples - 1)
+  // (the uints above fill their 16-byte rows; a new row of four)
+  uint environmentLight; // the environment's index in the light list, or INVALID_INDEX: no environment
+  uint reserved1;
+  uint reserved2;
+  uint reserved3;
   vec4 camPosition; // xyz, w = 1 for orthographic
   vec4 camRight;    // unit right * (tan(yfov/2) * aspect), or * xmag for orthographic
   vec4 camUp;       // unit up * tan(yfov/2), or * ymag for orthographic
   vec4 camForward;  // unit view direction
   vec4 sceneSphere; // bounding sphere of the scene: centre, radius (directional lights)
-  vec4 background;  // radiance of rays that escape the scene (rgb)
+  vec4 background;  // Scene::background (rgb), for tools; the stages see it as a uniform environment
 
   BUFREF(BvhNodes) bvh;
   BUFREF(Triangles) triangles;
@@ -267,8 +294,9 @@ struct Globals {
   BUFREF(TabTables) tabTables;
   BUFREF(Floats) tabData;      // the CDFs of every table
   BUFREF(Floats) measured;     // measured BRDF tables (merl: MERL_TABLE_FLOATS each, brdf/merl.h)
+  BUFREF(Environments) environment; // one GpuEnvironment (0 when the scene has none)
 };
-STATIC_ASSERT_SIZE(Globals, 64 + 6 * 16 + 30 * 8);
+STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 31 * 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 

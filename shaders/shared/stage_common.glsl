@@ -9,8 +9,14 @@
 #include "shared/rng.h"
 #include "shared/warp.h"
 #include "shared/bvh_traverse.glsl"
+#include "shared/envmap.h"
 
 layout(local_size_x = WORKGROUP_SIZE) in;
+
+// The shade stages of a scene without an environment compile its light-sampling branch out: a
+// render builds only what its scene needs (lavapipe's Mesa 22.3 ran every branch body a subgroup
+// reached, taken or not; reference/lavapipe.md). Constant 7: after the shade stages' own 0..6.
+layout(constant_id = 7) const bool HAS_ENVIRONMENT = true;
 
 // ---- Queues ---------------------------------------------------------------------------------
 
@@ -131,6 +137,17 @@ bool sampleLight(vec3 x, float uSelect, vec2 uPoint, out LightSample ls) {
     ls.value = g.materials.v[material].emission.xyz / ls.pdf;
     ls.dist = dist;
     return ls.pdf > 0.0f && isFinite(ls.pdf);
+  }
+  if (HAS_ENVIRONMENT && type == LIGHT_ENVIRONMENT) {
+    // The environment map, importance-sampled (shaders/shared/envmap.h); shadow rays go to infinity.
+    GpuEnvironment E = g.environment.v[0];
+    float pdf;
+    ls.wi = envSample(E, uPoint, pdf);
+    if (!(pdf > 0.0f)) return false;
+    ls.pdf = pSelect * pdf;
+    ls.dist = 3.0e38f;
+    ls.value = envRadiance(E, ls.wi) / ls.pdf;
+    return isFinite(ls.pdf);
   }
   if (type == LIGHT_DIRECTIONAL) {
     ls.wi = -light.direction.xyz;

@@ -1,7 +1,8 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // intersect: closest hit for every path in the current ray queue. Hits go to the shade queue of
-// their material's model; escaping rays pick up the background and end.
+// their material's model; escaping rays go to the escape queue when the scene has an environment
+// (escape.comp), and end otherwise.
 #include "shared/stage_common.glsl"
 STAGE_PUSH(BounceConstants);
 
@@ -21,9 +22,7 @@ void main() {
     g.pathHit.v[path] = vec4(t, b1, b2, uintBitsToFloat(tri));
     uint material = g.shading.v[tri].info.x;
     queuePush(QUEUE_SHADE_BASE + g.materials.v[material].info.w, path);
-  } else {
-    // Escape: the background is not light-sampled, so its weight is 1.
-    vec3 beta = g.pathThroughput.v[path].xyz;
-    g.pathRadiance.v[path].xyz += beta * g.background.xyz;
+  } else if (g.environmentLight != INVALID_INDEX) {
+    queuePush(QUEUE_ESCAPE, path);
   }
 }

@@ -6,6 +6,10 @@
 #include <vector>
 
 #include "scene/scene.h"
+
+namespace CLI {
+class App;
+}
 #include "util/stop_signal.h"
 
 namespace nusselt {
@@ -27,5 +31,21 @@ BrdfParams measuredParams(const ModelSpec& model, const std::string& file, const
 
 // The loader's warnings on stderr (unless quiet), with the count of dropped triangles.
 void printSceneWarnings(const Scene& scene, bool quiet);
+
+// The environment options of `render` and `preview` (docs/environment.md).
+struct EnvironmentArgs {
+  std::string env;       // --env FILE (.exr or .hdr) or "none"; empty: not given
+  std::string color;     // --env-color R,G,B; empty: not given
+  float scale = 1.0f;    // --env-scale
+  float rotate = 0.0f;   // --env-rotate, degrees about +Y
+  std::string select = "half";  // --env-select: half or power
+};
+// Registers --env, --env-color, --env-scale and --env-rotate on a subcommand.
+void addEnvironmentOptions(CLI::App& app, EnvironmentArgs& args);
+// Sets scene.environment from the options: reads the map (its warnings on stderr unless quiet),
+// or takes the colour; with neither, a scene without any light (no emissive triangle, no punctual
+// light, black background) gets the default, a uniform white environment of radiance 1, and a
+// warning naming the options. Throws nusselt::Error naming the option or the file on bad input.
+void applyEnvironmentOptions(Scene& scene, const EnvironmentArgs& args, bool quiet);
 
 }  // namespace nusselt

@@ -56,6 +56,7 @@ struct RenderArgs {
   double checkpointSeconds = 120;
   double timeBudget = 0;
   bool sppGiven = false;
+  EnvironmentArgs env;
 };
 
 int renderCommand(const RenderArgs& a) {
@@ -70,6 +71,7 @@ int renderCommand(const RenderArgs& a) {
 
   Scene scene = loadSceneOrDefault(a.scene, a.camera);
   printSceneWarnings(scene, a.quiet);
+  applyEnvironmentOptions(scene, a.env, a.quiet);
 
   RenderSettings s;
   s.seed = a.seed;
@@ -94,6 +96,7 @@ int renderCommand(const RenderArgs& a) {
   base.settings = s;
   base.camera = scene.hasCamera ? scene.camera : frameScene(scene);
   base.droppedTriangles = scene.droppedTriangles;
+  recordEnvironment(base, scene);
 
   // --resume: the saved render must be of this very render (scene and settings), fewer spp.
   Image saved;
@@ -151,6 +154,9 @@ int renderCommand(const RenderArgs& a) {
       std::fprintf(stderr, "scene: %s: %zu triangles, %zu materials (models: %s), %zu lights; BVH %u nodes in %.3f s\n",
                    scene.sourcePath.c_str(), sum.triangles, sum.materials, models.c_str(), sum.lights, sum.bvhNodes,
                    sum.bvhSeconds);
+      if (base.environment != "none")
+        std::fprintf(stderr, "environment: %s, scale %g, rotated %g degrees about +Y\n", base.environment.c_str(),
+                     base.envScale, base.envRotate);
       if (sum.samplerTrees && s.sampler == SamplerKind::Tabulated)
         std::fprintf(stderr, "sampler: %u tabulated tables (%.1f MiB) in %.2f s\n", sum.samplerTrees,
                      sum.samplerBytes / 1048576.0, sum.samplerSeconds);
@@ -282,6 +288,7 @@ struct BenchArgs {
   std::uint32_t maxDepth = 8;
   std::uint32_t samplesPerPass = 0;
   int device = -1;
+  EnvironmentArgs env;
 };
 
 double cpuSecondsUsed() {
@@ -313,6 +320,7 @@ int benchRenderCommand(const BenchArgs& a) {
               "samples/s", "Mrays/s", "CPU cores");
   for (const std::string& path : scenes) {
     Scene scene = loadSceneOrDefault(path, "");
+    applyEnvironmentOptions(scene, a.env, false);
     RenderSettings s;
     s.width = a.width;
     s.height = a.height;
@@ -543,6 +551,7 @@ int runCli(int argc, char** argv) {
   render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
   render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
   render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");
+  addEnvironmentOptions(*render, ra.env);
 
   CLI::App* devices = app.add_subcommand("devices", "List the Vulkan devices and whether nusselt can use them");
 
@@ -561,6 +570,7 @@ int runCli(int argc, char** argv) {
                           "Samples per pixel per pass (0: chosen for the device, as render does)")
       ->capture_default_str()->check(CLI::Range(0u, 4096u));
   benchRender->add_option("--device", ba.device, "Vulkan device index");
+  addEnvironmentOptions(*benchRender, ba.env);
 
   AlbedoArgs aa;
   CLI::App* albedo = app.add_subcommand("albedo", "Directional albedo of a reflectance model (cosine-weighted integral of its "

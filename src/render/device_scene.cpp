@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "../../shaders/shared/layout.h"
+#include "render/environment.h"
 #include "scene/bvh.h"
 
 namespace nusselt {
@@ -106,6 +107,24 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene) : m_ctx(ctx), m_b
     lights.push_back(l);
     weights.push_back(power);
   }
+
+  // ---- The environment: one light among the others, always chosen when alone. With others, by
+  // default with probability 1/2 (a fixed split: the power of an environment, which reaches only
+  // the parts of the scene that see the sky, compares badly with a lamp's); --env-select power:
+  // in proportion to its power through the scene's bounding disc, pi R^2 x integral of luminance
+  // over the sphere (pbrt-v4's ImageInfiniteLight::Phi). docs/environment.md measures both. ----
+  const Environment envDesc = effectiveEnvironment(scene);
+  const EnvironmentData env = buildEnvironment(envDesc);
+  if (env.emits()) {
+    double others = 0;
+    for (double w : weights) others += w;
+    GpuLight l{};
+    l.info = glm::uvec4(LIGHT_ENVIRONMENT, 0u, 0u, 0u);
+    m_environmentLight = static_cast<std::uint32_t>(lights.size());
+    lights.push_back(l);
+    const double power = M_PI * double(radius) * radius * env.luminanceIntegral;
+    weights.push_back(others <= 0 ? 1.0 : envDesc.selectByPower ? power : others);
+  }
   m_lights = weights.size();
 
   // ---- Light selection proportional to estimated power ----
@@ -138,14 +157,25 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene) : m_ctx(ctx), m_b
   make(m_shading, shading.size() * sizeof(GpuTriShading), "triangle shading", shading.data());
   make(m_lightBuffer, lights.size() * sizeof(GpuLight), "light", lights.data());
   make(m_lightCdf, cdf.size() * sizeof(float), "light CDF", cdf.data());
+  if (env.emits()) {
+    make(m_envTexels, env.texels.size() * sizeof(glm::vec4), "environment texels", env.texels.data());
+    make(m_envDistribution, env.distribution.size() * sizeof(float), "environment distribution", env.distribution.data());
+    shared::GpuEnvironment e = env.gpu;
+    e.texels = m_envTexels.address;
+    e.distribution = m_envDistribution.address;
+    make(m_envStruct, sizeof e, "environment", &e);
+  }
 }
 
 DeviceScene::~DeviceScene() {
-  for (vk::Buffer* b : {&m_bvh, &m_tris, &m_shading, &m_lightBuffer, &m_lightCdf}) vk::destroyBuffer(m_ctx, *b);
+  for (vk::Buffer* b : {&m_bvh, &m_tris, &m_shading, &m_lightBuffer, &m_lightCdf, &m_envTexels, &m_envDistribution,
+                        &m_envStruct})
+    if (b->buffer) vk::destroyBuffer(m_ctx, *b);
 }
 
 std::uint64_t DeviceScene::deviceBytes() const {
-  return m_bvh.size + m_tris.size + m_shading.size + m_lightBuffer.size + m_lightCdf.size;
+  return m_bvh.size + m_tris.size + m_shading.size + m_lightBuffer.size + m_lightCdf.size + m_envTexels.size +
+         m_envDistribution.size + m_envStruct.size;
 }
 
 void DeviceScene::fillGlobals(shared::Globals& g) const {
@@ -157,6 +187,8 @@ void DeviceScene::fillGlobals(shared::Globals& g) const {
   g.sceneSphere = m_sphere;
   g.background = v4(m_background);
   g.lightCount = static_cast<std::uint32_t>(m_lights);
+  g.environmentLight = m_environmentLight;
+  g.environment = m_envStruct.buffer ? m_envStruct.address : 0;
   g.triangleCount = static_cast<std::uint32_t>(m_triangles);
 }
 

@@ -37,6 +37,8 @@ class DeviceScene {
   std::uint64_t deviceBytes() const;
   // Bounding sphere of the triangles (centre, radius; radius 1 without triangles).
   glm::vec4 boundingSphere() const { return m_sphere; }
+  // The scene has an environment that emits (a light, and an escape stage for missed rays).
+  bool hasEnvironment() const { return m_environmentLight != 0xffffffffu; }
 
  private:
   vk::Context& m_ctx;
@@ -46,7 +48,9 @@ class DeviceScene {
   double m_bvhSeconds = 0;
   glm::vec4 m_sphere{0.0f, 0.0f, 0.0f, 1.0f};
   glm::vec3 m_background{0.0f};
+  std::uint32_t m_environmentLight = 0xffffffffu;  // index in the light list, INVALID_INDEX: none
   vk::Buffer m_bvh, m_tris, m_shading, m_lightBuffer, m_lightCdf;
+  vk::Buffer m_envTexels, m_envDistribution, m_envStruct;  // empty without an environment
 };
 
 }  // namespace nusselt

@@ -73,6 +73,8 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   g.stats = m_stats->address;
   g.maxDepth = m_settings.maxDepth;
   g.pathCapacity = m_capacity;
+  // The escape stage exists only for scenes with an environment (the device scene set it up).
+  m_hasEscape = g.environmentLight != INVALID_INDEX;
 
   auto t0 = std::chrono::steady_clock::now();
   createPipelines();
@@ -100,7 +102,8 @@ PathIntegrator::~PathIntegrator() {
   if (m_fence) vkDestroyFence(d, m_fence, nullptr);
   if (m_queryPool) vkDestroyQueryPool(d, m_queryPool, nullptr);
   if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
-  for (auto* p : {&m_camera, &m_submit, &m_intersect, &m_shadow, &m_accumulate}) vk::destroyComputePipeline(m_ctx, *p);
+  for (auto* p : {&m_camera, &m_submit, &m_intersect, &m_escape, &m_shadow, &m_accumulate})
+    if (p->pipeline) vk::destroyComputePipeline(m_ctx, *p);
   for (auto& p : m_shade) vk::destroyComputePipeline(m_ctx, p);
   for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
 }
@@ -124,6 +127,7 @@ void PathIntegrator::createPipelines() {
   m_camera = vk::createComputePipeline(m_ctx, layout, "camera");
   m_submit = vk::createComputePipeline(m_ctx, layout, "submit");
   m_intersect = vk::createComputePipeline(m_ctx, layout, "intersect");
+  if (m_hasEscape) m_escape = vk::createComputePipeline(m_ctx, layout, "escape");
   m_shadow = vk::createComputePipeline(m_ctx, layout, "shadow");
   m_accumulate = vk::createComputePipeline(m_ctx, layout, "accumulate");
   // Only the models (and combinations) this scene uses: one specialised shade pipeline each,
@@ -146,6 +150,10 @@ void PathIntegrator::createPipelines() {
             spec.push_back(key[0]);
             for (std::uint32_t k = 0; k < MAX_COMPONENTS; ++k) spec.push_back(k < key[0] ? key[1 + k] : key[1]);
           }
+          // Constant 7 (stage_common.glsl): HAS_ENVIRONMENT; ids 2..6 that a single-model module
+          // lacks are ignored by Vulkan.
+          spec.resize(7, 0u);
+          spec.push_back(m_hasEscape ? 1u : 0u);
           // One module per strategy (CMakeLists.txt): shade_sN / shade_combined_sN.
           const std::string module = std::string(key[0] > 0 ? "shade_combined" : "shade") + "_s" + std::to_string(sampler);
           m_shade[s] = vk::createComputePipeline(m_ctx, layout, module, spec);
@@ -208,9 +216,15 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
     vkCmdDispatchIndirect(cmd, m_args->buffer, rayQueue * sizeof(DispatchArgs));
     vk::computeBarrier(cmd);
     mark(cmd, "intersect");
-    // shade(model) <- shade queues; empties the consumed ray queue.
-    dispatchSubmit(cmd, INVALID_INDEX, rayQueue, 1, QUEUE_SHADE_BASE, slots);
+    // escape, shade(model) <- escape and shade queues; empties the consumed ray queue.
+    dispatchSubmit(cmd, INVALID_INDEX, rayQueue, 1, QUEUE_ESCAPE, slots + 1);
     mark(cmd, "submit");
+    if (m_hasEscape) {
+      bindAndPush(m_escape);
+      vkCmdDispatchIndirect(cmd, m_args->buffer, QUEUE_ESCAPE * sizeof(DispatchArgs));
+      vk::computeBarrier(cmd);
+      mark(cmd, "escape");
+    }
     for (std::uint32_t s = 0; s < slots; ++s) {
       pc.modelSlot = s;
       bindAndPush(m_shade[s]);
@@ -221,8 +235,8 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
       }
     }
     vk::computeBarrier(cmd);
-    // shadow <- shadow queue; empties the shade queues.
-    dispatchSubmit(cmd, QUEUE_SHADOW, QUEUE_SHADE_BASE, slots, 0, 0);
+    // shadow <- shadow queue; empties the escape and shade queues.
+    dispatchSubmit(cmd, QUEUE_SHADOW, QUEUE_ESCAPE, slots + 1, 0, 0);
     mark(cmd, "submit");
     bindAndPush(m_shadow);
     vkCmdDispatchIndirect(cmd, m_args->buffer, QUEUE_SHADOW * sizeof(DispatchArgs));

@@ -1,6 +1,7 @@
 // path_integrator.h: the wavefront path tracer. Each pass traces one path per pixel through the
 // stages
-//   camera -> [intersect -> shade(slot) -> shadow] x (max depth + 1) -> accumulate
+//   camera -> [intersect -> escape -> shade(slot) -> shadow] x (max depth + 1) -> accumulate
+// (escape only for scenes with an environment)
 // with queues between them: a queue is a count plus path ids, and the one-workgroup submit stage
 // turns counts into indirect dispatch sizes, so every stage processes only live paths.
 #pragma once
@@ -62,7 +63,8 @@ class PathIntegrator : public Integrator {
   vk::Buffer* m_args = nullptr;
   vk::Buffer* m_stats = nullptr;
 
-  vk::ComputePipeline m_camera, m_submit, m_intersect, m_shadow, m_accumulate;
+  vk::ComputePipeline m_camera, m_submit, m_intersect, m_escape, m_shadow, m_accumulate;
+  bool m_hasEscape = false;
   std::vector<vk::ComputePipeline> m_shade;  // one per slot
   VkCommandBuffer m_cmd = VK_NULL_HANDLE;
   VkFence m_fence = VK_NULL_HANDLE;

@@ -97,6 +97,7 @@ struct PreviewArgs {
   std::vector<std::string> testKeys;
   bool validation = false;
   bool quiet = false;
+  EnvironmentArgs env;
 };
 
 // Test harness: a key as written in --test-keys ("S", "2", "Left", "Shift+Up", "]", ...).
@@ -401,6 +402,7 @@ void Preview::restartLoop() {
   base.settings = m_settings;
   base.camera = m_renderer->camera();
   base.droppedTriangles = m_scene.droppedTriangles;
+  recordEnvironment(base, m_scene);
   RenderLoopOptions lo;
   lo.spp = m_args.maxSpp ? m_args.maxSpp : (1u << 30);
   lo.progress = false;
@@ -675,6 +677,7 @@ int Preview::run() {
 
   m_scene = loadSceneOrDefault(a.scene, a.camera);
   printSceneWarnings(m_scene, a.quiet);
+  applyEnvironmentOptions(m_scene, a.env, a.quiet);
   m_settings.seed = a.seed;
   m_settings.maxDepth = a.maxDepth;
   parseLighting(a.lighting, m_settings.lighting);
@@ -878,6 +881,7 @@ void registerPreviewCommand(CLI::App& app, CommandRunner& run) {
       "preview", "Open a window that shows the render converging (progressive, same integrator as `render`)");
   p->footer(kKeysHelp);
   p->add_option("scene", a->scene, "glTF 2.0 scene (.gltf or .glb); omitted: the built-in Cornell box");
+  addEnvironmentOptions(*p, a->env);
   p->add_option("--width", a->width, "Window (and render) width in pixels (default 512, or from --height and the camera)")
       ->check(CLI::Range(1u, 16384u));
   p->add_option("--height", a->height, "Window (and render) height in pixels (default from the width and the camera)")

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "render/environment.h"
 #include "util/error.h"
 
 namespace nusselt {
@@ -38,6 +39,33 @@ bool parseCamera(const std::string& text, Camera& c) {
 
 }  // namespace
 
+namespace {
+std::string number(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+}  // namespace
+
+std::string describeEnvironment(const Scene& scene) {
+  const Environment e = effectiveEnvironment(scene);
+  if (e.kind == EnvironmentKind::Map) return "map " + e.path;
+  if (e.kind == EnvironmentKind::Uniform) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "uniform %.9g,%.9g,%.9g", e.color.x, e.color.y, e.color.z);
+    return buf;
+  }
+  return "none";
+}
+
+void recordEnvironment(RenderRecord& r, const Scene& scene) {
+  const Environment e = effectiveEnvironment(scene);
+  r.environment = describeEnvironment(scene);
+  r.envScale = e.scale;
+  r.envRotate = e.rotateDegrees;
+  r.envSelect = e.selectByPower ? "power" : "half";
+}
+
 ImageMetadata makeMetadata(const RenderRecord& r) {
   ImageMetadata meta;
   meta.strings = {{"nusselt/version", NUSSELT_VERSION},
@@ -53,7 +81,9 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
                   {"nusselt/sampler", samplerName(r.settings.sampler)},
                   {"nusselt/components", componentSelectionName(r.settings.components)},
                   {"nusselt/models", r.models},
-                  {"nusselt/camera", cameraText(r.camera)}};
+                  {"nusselt/camera", cameraText(r.camera)},
+                  {"nusselt/environment", r.environment},
+                  {"nusselt/envSelect", r.envSelect}};
   meta.ints = {{"nusselt/spp", r.spp},
                {"nusselt/sppOffset", r.settings.sampleOffset},
                {"nusselt/seed", r.settings.seed},
@@ -64,7 +94,10 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
   r.stats.forEach([&](const char* name, const char*, std::uint64_t value) {
     meta.ints.push_back({std::string("nusselt/") + name, static_cast<std::int64_t>(value)});
   });
-  meta.doubles = {{"nusselt/renderSeconds", r.renderSeconds}, {"nusselt/totalSeconds", r.totalSeconds}};
+  meta.doubles = {{"nusselt/renderSeconds", r.renderSeconds},
+                  {"nusselt/totalSeconds", r.totalSeconds},
+                  {"nusselt/envScale", r.envScale},
+                  {"nusselt/envRotate", r.envRotate}};
   if (r.timeBudget > 0) meta.doubles.push_back({"nusselt/timeBudget", r.timeBudget});
   if (r.source == "preview") meta.doubles.push_back({"nusselt/exposure", r.displayExposure});
   return meta;
@@ -120,6 +153,11 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   r.totalSeconds = findDouble(meta, "nusselt/totalSeconds").value_or(0);
   r.timeBudget = findDouble(meta, "nusselt/timeBudget").value_or(0);
   r.displayExposure = findDouble(meta, "nusselt/exposure").value_or(0);
+  // Absent in files written before environments existed: those rendered without one.
+  r.environment = findString(meta, "nusselt/environment").value_or("none");
+  r.envScale = findDouble(meta, "nusselt/envScale").value_or(1);
+  r.envRotate = findDouble(meta, "nusselt/envRotate").value_or(0);
+  r.envSelect = findString(meta, "nusselt/envSelect").value_or("half");
   return r;
 }
 
@@ -140,7 +178,11 @@ std::string firstDifference(const RenderRecord& a, const RenderRecord& b) {
         differ("the component selection (--components)", componentSelectionName(s.components),
                componentSelectionName(t.components)),
         differ("the roulette (--roulette)", rouletteModeName(s.roulette), rouletteModeName(t.roulette)),
-        differ("the camera", cameraText(a.camera), cameraText(b.camera))})
+        differ("the camera", cameraText(a.camera), cameraText(b.camera)),
+        differ("the environment (--env, --env-color)", a.environment, b.environment),
+        differ("the environment scale (--env-scale)", number(a.envScale), number(b.envScale)),
+        differ("the environment rotation (--env-rotate)", number(a.envRotate), number(b.envRotate)),
+        differ("the environment's selection (--env-select)", a.envSelect, b.envSelect)})
     if (!d.empty()) return d;
   return {};
 }

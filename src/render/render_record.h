@@ -29,7 +29,17 @@ struct RenderRecord {
   double totalSeconds = 0;
   double timeBudget = 0;          // --time, 0: none
   double displayExposure = 0;     // the preview's display exposure in stops (recorded for previews only)
+  // The environment (docs/environment.md): "none", "uniform R,G,B" or "map FILE" (describeEnvironment).
+  std::string environment = "none";
+  double envScale = 1, envRotate = 0;
+  std::string envSelect = "half";  // --env-select
 };
+
+// The record's description of an environment ("none", "uniform R,G,B", "map FILE"); a scene's
+// background alone counts as a uniform environment (effectiveEnvironment).
+std::string describeEnvironment(const Scene& scene);
+// Sets record.environment, envScale and envRotate from the scene.
+void recordEnvironment(RenderRecord& record, const Scene& scene);
 
 // The header attributes of a render.
 ImageMetadata makeMetadata(const RenderRecord& record);

@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "../../shaders/shared/layout.h"
+#include "render/environment.h"
 #include "render/path_integrator.h"
 #include "util/error.h"
 
@@ -54,11 +55,16 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
     m_samplesPerPass = PathIntegrator::samplesPerPassFor(
         settings, pixels, m_ctx.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
     const std::uint32_t capacity = PathIntegrator::capacityFor(settings, pixels, m_samplesPerPass);
-    const std::uint64_t need = DeviceScene::bytesFor(scene.triangleCount(), lightBound) +
+    auto mib = [](std::uint64_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
+    const std::uint64_t envBytes = environmentBytes(effectiveEnvironment(scene));
+    if (m_ctx.maxAllocation && envBytes > m_ctx.maxAllocation)
+      throw Error("environment map '" + scene.environment.path + "' (" + std::to_string(scene.environment.width) + "x" +
+                  std::to_string(scene.environment.height) + ") needs " + mib(envBytes) + " of device memory, more than " +
+                  m_ctx.deviceName + " allows in one allocation (" + mib(m_ctx.maxAllocation) + "): use a smaller map");
+    const std::uint64_t need = DeviceScene::bytesFor(scene.triangleCount(), lightBound + 1) + envBytes +
                                std::max<std::size_t>(scene.materials.size(), 1) * sizeof(shared::GpuMaterial) +
                                Film::bytesFor(pixels) + PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS);
     const std::uint64_t have = vk::deviceLocalHeapSize(m_ctx);
-    auto mib = [](std::uint64_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
     // The film is the largest single buffer (16 bytes per pixel, twice): one allocation each.
     if (m_ctx.maxAllocation && pixels * 16 > m_ctx.maxAllocation)
       throw Error("a " + std::to_string(settings.width) + "x" + std::to_string(settings.height) + " film needs " +

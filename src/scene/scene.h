@@ -127,6 +127,25 @@ struct Camera {
   float xmag = 1.0f, ymag = 1.0f;        // half extents (orthographic)
 };
 
+// The light from around the scene, seen by rays that escape it (docs/environment.md): none, a
+// uniform radiance, or an equirectangular (lat-long) radiance map (shaders/shared/envmap.h for
+// its convention).
+enum class EnvironmentKind { None, Uniform, Map };
+struct Environment {
+  EnvironmentKind kind = EnvironmentKind::None;
+  std::string path;             // Map: the file it was read from (recorded in the EXR header)
+  int width = 0, height = 0;    // Map
+  std::vector<float> rgb;       // Map: 3 * width * height linear Rec. 709 radiances, top row first
+  glm::vec3 color{0.0f};        // Uniform: the radiance
+  float scale = 1.0f;           // radiance multiplier (--env-scale)
+  float rotateDegrees = 0.0f;   // rotation about +Y, counter-clockwise seen from above (--env-rotate)
+  // How light sampling chooses the environment when the scene has other lights (--env-select):
+  // false = half of the light samples (the default), true = in proportion to estimated power.
+  bool selectByPower = false;
+
+  bool present() const { return kind != EnvironmentKind::None; }
+};
+
 struct Scene {
   std::string sourcePath;
   // Three entries per triangle, world space. Degenerate triangles never get here.
@@ -150,7 +169,8 @@ struct Scene {
   std::vector<PunctualLight> lights;
   Camera camera;
   bool hasCamera = false;  // false: the renderer frames the scene with a default view
-  glm::vec3 background{0.0f};  // radiance of escaping rays
+  glm::vec3 background{0.0f};  // radiance of escaping rays: a uniform environment when `environment` is None
+  Environment environment;
   std::uint64_t droppedTriangles = 0;  // skipped: zero area, non-finite vertex, or a coordinate beyond 1e15
   std::vector<std::string> warnings;   // one line each, printed once by the caller
 

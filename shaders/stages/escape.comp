@@ -1,0 +1,35 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// escape: rays that left the scene (the escape queue, filled by intersect) pick up the
+// environment's radiance in their direction, weighted by MIS against light sampling of the
+// environment: the power heuristic of the BSDF pdf the ray was drawn with (path direction w) and
+// the pdf with which NEE would have drawn it (selection probability x envPdf). Camera rays and
+// rays after a delta lobe (pdf 0) take weight 1. Dispatched only when the scene has an
+// environment (Globals.environmentLight != INVALID_INDEX).
+#include "shared/stage_common.glsl"
+STAGE_PUSH(BounceConstants);
+
+void main() {
+  uint idx = gl_GlobalInvocationID.x;
+  if (idx >= queueCount(QUEUE_ESCAPE)) return;
+  uint path = queueItem(QUEUE_ESCAPE, idx);
+  vec4 rayD = g.pathDirection.v[path];
+  vec3 dir = rayD.xyz;
+  float prevPdf = rayD.w;
+  GpuEnvironment E = g.environment.v[0];
+
+  // ---- MIS weight: the BSDF sample against light sampling of the environment ----
+  float w = 1.0f;
+  if (pc.bounce > 0u && prevPdf > 0.0f) {
+    if (g.lighting == LIGHTING_NEE_ONLY) {
+      w = 0.0f;
+    } else if (g.lighting == LIGHTING_MIS) {
+      float lightPdf = lightSelectPdf(g.environmentLight) * envPdf(E, dir);
+      w = powerHeuristic(prevPdf, lightPdf);
+    }
+  }
+  if (w > 0.0f) {
+    vec3 beta = g.pathThroughput.v[path].xyz;
+    g.pathRadiance.v[path].xyz += beta * envRadiance(E, dir) * w;
+  }
+}
