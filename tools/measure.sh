@@ -10,7 +10,8 @@ tmp=$(mktemp)
 {
   echo "# Measurements"
   echo
-  echo "Produced by \`tools/measure.sh\` on $(date -u +%Y-%m-%d) ($(nproc) cores, $(uname -m))."
+  echo "Produced by \`tools/measure.sh\` on $(date -u +%Y-%m-%d) ($(nproc) cores, $(uname -m), load average $(cut -d' ' -f1-3 /proc/loadavg) at the start:"
+  echo "timings on a shared machine are only comparable with others taken at the same load)."
   echo "Every block is the verbatim output of the command above it."
   for cmd in "bench render" "bench pipelines" "bench precompute" "bench precompute --preset hard --audit 16"; do
     echo

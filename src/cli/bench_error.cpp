@@ -400,7 +400,7 @@ RenderResult renderTimed(vk::Context& ctx, const Scene& scene, RenderSettings s)
   RenderResult out;
   Renderer r(ctx, scene, s);
   out.buildSeconds = r.summary().samplerSeconds;
-  r.renderPass();  // warm-up: lavapipe compiles each pipeline at its first dispatch
+  r.renderPass(1);  // warm-up: lavapipe compiles each pipeline at its first dispatch
   r.reset();
   auto t0 = std::chrono::steady_clock::now();
   while (r.samplesDone() < s.spp) {
