@@ -295,8 +295,12 @@ struct Globals {
   BUFREF(Floats) tabData;      // the CDFs of every table
   BUFREF(Floats) measured;     // measured BRDF tables (merl: MERL_TABLE_FLOATS each, brdf/merl.h)
   BUFREF(Environments) environment; // one GpuEnvironment (0 when the scene has none)
+  // The top-level acceleration structure's device address, low and high 32 bits, for ray queries
+  // (shaders/shared/trace.glsl with NUSSELT_RAY_QUERY); 0 when the GLSL BVH traces.
+  uint tlasLow;
+  uint tlasHigh;
 };
-STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 31 * 8);
+STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 31 * 8 + 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 
@@ -344,6 +348,17 @@ struct SampleToolConstants {
   vec4 v;
 };
 STATIC_ASSERT_SIZE(SampleToolConstants, 32);
+
+// trace_tool (the traversal tests): traces rays 0 .. count - 1 of the shadow-ray arrays (origin,
+// w = tmax; direction) with both scene queries of shared/trace.glsl; writes pathHit = (t, b1, b2,
+// triangle bits) of traceClosest and pathInfo = (traceAny's answer 1 or 0, traceClosest's 1 or 0, 0, 0).
+struct TraceToolConstants {
+  uint count;
+  uint reserved0;
+  uint reserved1;
+  uint reserved2;
+};
+STATIC_ASSERT_SIZE(TraceToolConstants, 16);
 
 // The pipeline layout's push-constant range: the largest of the structs above.
 #define STAGE_PUSH_BYTES 32u

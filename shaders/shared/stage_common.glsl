@@ -1,14 +1,18 @@
 // stage_common.glsl: what every wavefront stage shares (GLSL only): extensions, the globals,
-// queues, ray offsets and light sampling. Included first by each shaders/stages/*.comp.
+// queues, ray offsets, light sampling and the scene queries (trace.glsl). Included first by
+// each shaders/stages/*.comp.
 #extension GL_EXT_buffer_reference : require
 #extension GL_EXT_scalar_block_layout : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_ballot : require
+#ifdef NUSSELT_RAY_QUERY
+#extension GL_EXT_ray_query : require
+#endif
 
 #include "shared/layout.h"
 #include "shared/rng.h"
 #include "shared/warp.h"
-#include "shared/bvh_traverse.glsl"
+#include "shared/trace.glsl"
 #include "shared/envmap.h"
 
 layout(local_size_x = WORKGROUP_SIZE) in;

@@ -49,6 +49,7 @@ struct RenderArgs {
   std::string sampler = "quadtree";
   std::string components = "albedo";
   std::string roulette = "throughput";
+  std::string traversal = "auto";
   bool variance = false;
   bool validation = false;
   bool quiet = false;
@@ -83,6 +84,7 @@ int renderCommand(const RenderArgs& a) {
   parseSampler(a.sampler, s.sampler);
   parseComponentSelection(a.components, s.components);
   parseRouletteMode(a.roulette, s.roulette);
+  parseTraversal(a.traversal, s.traversal);
   // Image size: defaults follow the camera's aspect ratio when only one side (or none) is given.
   float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
   s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u);
@@ -128,6 +130,7 @@ int renderCommand(const RenderArgs& a) {
   vk::ContextOptions co;
   co.deviceIndex = a.device;
   co.validation = a.validation || validationFromEnvironment();
+  co.rayQuery = s.traversal != Traversal::Bvh;
   vk::createContext(ctx, co);
   int status = kExitOk;
   {
@@ -147,13 +150,23 @@ int renderCommand(const RenderArgs& a) {
       if (previous.device != ctx.deviceName && !a.quiet)
         std::fprintf(stderr, "warning: %s was rendered on %s; continuing on %s (not bit-identical to an uninterrupted render)\n",
                      a.resume.c_str(), previous.device.c_str(), ctx.deviceName.c_str());
+      else if (previous.settings.traversal != renderer.settings().traversal && !a.quiet)
+        std::fprintf(stderr, "warning: %s was traced with --traversal %s; continuing with %s (not bit-identical to an "
+                             "uninterrupted render)\n",
+                     a.resume.c_str(), traversalName(previous.settings.traversal),
+                     traversalName(renderer.settings().traversal));
       renderer.restoreAccumulation(saved, previous.spp);
       renderer.addStats(previous.stats);
     }
     if (!a.quiet) {
-      std::fprintf(stderr, "scene: %s: %zu triangles, %zu materials (models: %s), %zu lights; BVH %u nodes in %.3f s\n",
-                   scene.sourcePath.c_str(), sum.triangles, sum.materials, models.c_str(), sum.lights, sum.bvhNodes,
-                   sum.bvhSeconds);
+      char structures[128];
+      if (sum.traversal == Traversal::RayQuery)
+        std::snprintf(structures, sizeof structures, "acceleration structures %.1f MiB in %.3f s",
+                      sum.accelerationBytes / 1048576.0, sum.accelerationSeconds);
+      else
+        std::snprintf(structures, sizeof structures, "BVH %u nodes in %.3f s", sum.bvhNodes, sum.bvhSeconds);
+      std::fprintf(stderr, "scene: %s: %zu triangles, %zu materials (models: %s), %zu lights; %s\n",
+                   scene.sourcePath.c_str(), sum.triangles, sum.materials, models.c_str(), sum.lights, structures);
       if (base.environment != "none")
         std::fprintf(stderr, "environment: %s, scale %g, rotated %g degrees about +Y\n", base.environment.c_str(),
                      base.envScale, base.envRotate);
@@ -166,12 +179,12 @@ int renderCommand(const RenderArgs& a) {
                      sum.samplerCacheMisses, sum.samplerCacheRejected);
       std::string budget = a.timeBudget > 0 ? ", time budget " + std::to_string(a.timeBudget) + " s" : "";
       std::fprintf(stderr, "device: %s (%s); %ux%u, %s spp%s%s (%u per pass), max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
-                           "roulette %s\n",
+                           "roulette %s, traversal %s\n",
                    ctx.deviceName.c_str(), ctx.driverInfo.c_str(), s.width, s.height,
                    targetSpp == (1u << 30) ? "unlimited" : std::to_string(targetSpp).c_str(),
                    a.resume.empty() ? "" : (" (resuming from " + std::to_string(previous.spp) + ")").c_str(),
                    budget.c_str(), renderer.samplesPerPass(), s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng),
-                   samplerName(s.sampler), rouletteModeName(s.roulette));
+                   samplerName(s.sampler), rouletteModeName(s.roulette), traversalName(sum.traversal));
     }
 
     base.totalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();  // set-up
@@ -244,6 +257,11 @@ int mergeCommand(const std::vector<std::string>& inputs, const std::string& outp
       const std::string d = firstDifference(merged, r);
       if (!d.empty()) throw Error(inputs[k] + ": " + d + " (" + inputs[0] + " vs this file): only renders of the same "
                                   "scene and settings can be merged");
+      if (r.settings.traversal != merged.settings.traversal)
+        std::fprintf(stderr, "note: %s was traced with --traversal %s, %s with %s (both estimate the same image); the "
+                             "merged header names %s\n",
+                     inputs[k].c_str(), traversalName(r.settings.traversal), inputs[0].c_str(),
+                     traversalName(merged.settings.traversal), traversalName(merged.settings.traversal));
       for (std::size_t i = 0; i < total.sum.size(); ++i) {
         total.sum[i] += img.sum[i];
         total.sumSq[i] += img.sumSq[i];
@@ -275,9 +293,11 @@ int devicesCommand() {
     return kExitFailure;
   }
   for (const auto& d : devices)
-    std::printf("%u: %s (%s, Vulkan %u.%u, driver %s, %.0f MiB device-local)%s%s\n", d.index, d.name.c_str(),
+    std::printf("%u: %s (%s, Vulkan %u.%u, driver %s, %.0f MiB device-local, %s)%s%s\n", d.index, d.name.c_str(),
                 d.type.c_str(), VK_API_VERSION_MAJOR(d.apiVersion), VK_API_VERSION_MINOR(d.apiVersion),
-                d.driverInfo.c_str(), d.deviceLocalBytes / 1048576.0, d.suitable ? "" : ": not usable: ", d.whyNot.c_str());
+                d.driverInfo.c_str(), d.deviceLocalBytes / 1048576.0,
+                d.rayQuery ? "ray queries" : "no ray queries: BVH traversal", d.suitable ? "" : ": not usable: ",
+                d.whyNot.c_str());
   return kExitOk;
 }
 
@@ -288,6 +308,8 @@ struct BenchArgs {
   std::uint32_t maxDepth = 8;
   std::uint32_t samplesPerPass = 0;
   int device = -1;
+  std::vector<std::string> traversals{"auto"};
+  std::uint32_t repeats = 1;
   EnvironmentArgs env;
 };
 
@@ -297,11 +319,109 @@ double cpuSecondsUsed() {
   return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
-// Throughput of the path tracer: for each scene, samples/s and rays/s over `spp` samples per
-// pixel after a warm-up pass (lavapipe compiles a pipeline at its first dispatch), the CPU time
-// the process used per second of wall time (a CPU device should keep every core busy), GPU time
-// per stage and per shade pipeline (timestamps; a barrier after each shade pipeline in this
-// mode), and the extension rays per bounce (the queue sizes the wavefront works through).
+// The figures of one timed render of bench render (medians over repeats).
+struct BenchRun {
+  double setupSeconds = 0;   // the Renderer: BVH or acceleration structures, quadtrees, pipelines
+  double warmupSeconds = 0;  // the untimed first pass (lavapipe compiles each pipeline at its first dispatch)
+  double samplesPerSecond = 0;
+  double mraysPerSecond = 0;
+  double cpuCores = 0;
+};
+
+// One render of `scene` with `traversal`: prints its row, its GPU time by stage and shade
+// pipeline, and the paths alive per bounce.
+BenchRun benchRenderOnce(vk::Context& ctx, const Scene& scene, const std::string& path, const BenchArgs& a,
+                         Traversal traversal) {
+  RenderSettings s;
+  s.width = a.width;
+  s.height = a.height;
+  s.spp = a.spp;
+  s.maxDepth = a.maxDepth;
+  s.samplesPerPass = a.samplesPerPass;
+  s.timeStages = true;
+  s.traversal = traversal;
+  BenchRun run;
+  const auto tSetup = std::chrono::steady_clock::now();
+  Renderer r(ctx, scene, s);
+  const auto tWarm = std::chrono::steady_clock::now();
+  r.renderPass(1);  // warm-up: lavapipe compiles each pipeline at its first dispatch
+  run.setupSeconds = std::chrono::duration<double>(tWarm - tSetup).count();
+  run.warmupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tWarm).count();
+  const std::vector<std::pair<std::string, double>> warm = r.stageSeconds();
+  const std::vector<std::uint64_t> warmRays = r.raysPerBounce();
+  const RenderStats before = r.stats();
+  const double cpu0 = cpuSecondsUsed();
+  const auto t0 = std::chrono::steady_clock::now();
+  r.render(1 + a.spp);
+  const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double cpu = cpuSecondsUsed() - cpu0;
+  const RenderStats after = r.stats();
+  const double rays = double(after.rays - before.rays + after.shadowRays - before.shadowRays);
+  const double samples = double(a.spp) * s.width * s.height;
+  run.samplesPerSecond = samples / sec;
+  run.mraysPerSecond = rays / sec / 1e6;
+  run.cpuCores = cpu / sec;
+  char size[32];
+  std::snprintf(size, sizeof size, "%ux%u", s.width, s.height);
+  std::printf("%-34s %9zu %9s %9s %5u %6u %8.3f %11.0f %8.3f %9.2f %8.3f %9.3f\n",
+              path.empty() ? "default (cornell-box)" : std::filesystem::path(path).filename().c_str(),
+              r.summary().triangles, size, traversalName(r.settings().traversal), a.spp, r.samplesPerPass(), sec,
+              run.samplesPerSecond, run.mraysPerSecond, run.cpuCores, run.setupSeconds, run.warmupSeconds);
+  double gpu = 0;
+  std::vector<std::pair<std::string, double>> timed;
+  for (auto& [name, t] : r.stageSeconds()) {
+    double w = 0;
+    for (auto& [n0, t0s] : warm)
+      if (n0 == name) w = t0s;
+    timed.push_back({name, t - w});
+    gpu += t - w;
+  }
+  if (gpu > 0) {
+    std::string stages, shades;
+    for (auto& [name, t] : timed) {
+      char buf[96];
+      const bool shade = name.rfind("shade ", 0) == 0;
+      std::snprintf(buf, sizeof buf, "%s%s %.1f%%", (shade ? shades : stages).empty() ? "" : ", ",
+                    shade ? name.c_str() + 6 : name.c_str(), 100.0 * t / gpu);
+      (shade ? shades : stages) += buf;
+    }
+    std::printf("    GPU time %.3f s by stage: %s\n", gpu, stages.c_str());
+    if (!shades.empty()) std::printf("    shade pipelines (model: share of GPU time): %s\n", shades.c_str());
+  }
+  std::string perBounce;
+  const std::vector<std::uint64_t>& bounces = r.raysPerBounce();
+  for (std::size_t b = 0; b < bounces.size(); ++b) {
+    const std::uint64_t n = bounces[b] - (b < warmRays.size() ? warmRays[b] : 0);
+    if (n == 0) continue;
+    char buf[48];
+    std::snprintf(buf, sizeof buf, "%s%zu:%.3g", perBounce.empty() ? "" : " ", b, double(n) / samples);
+    perBounce += buf;
+  }
+  std::printf("    paths per sample alive at bounce (bounce:fraction): %s\n", perBounce.c_str());
+  std::fflush(stdout);
+  return run;
+}
+
+// "median [min-max]" of the values picked from runs.
+template <class F>
+std::string medianRange(const std::vector<BenchRun>& runs, F pick, const char* format) {
+  std::vector<double> v;
+  for (const BenchRun& r : runs) v.push_back(pick(r));
+  std::sort(v.begin(), v.end());
+  double median = v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+  char buf[96];
+  std::string f = std::string(format) + " [" + format + "-" + format + "]";
+  std::snprintf(buf, sizeof buf, f.c_str(), median, v.front(), v.back());
+  return buf;
+}
+
+// Throughput of the path tracer: for each scene (and traversal, interleaved within each repeat),
+// samples/s and rays/s over `spp` samples per pixel after a warm-up pass (lavapipe compiles a
+// pipeline at its first dispatch), the CPU time the process used per second of wall time (a CPU
+// device should keep every core busy), GPU time per stage and per shade pipeline (timestamps; a
+// barrier after each shade pipeline in this mode), the extension rays per bounce (the queue
+// sizes the wavefront works through), and the set-up (BVH or acceleration structures, quadtrees,
+// pipelines) and warm-up times. With repeats, the medians and ranges per traversal.
 int benchRenderCommand(const BenchArgs& a) {
   std::vector<std::string> scenes = a.scenes;
   if (scenes.empty()) {
@@ -310,73 +430,39 @@ int benchRenderCommand(const BenchArgs& a) {
     if (std::filesystem::exists(dragon)) scenes.push_back(dragon);
     else std::fprintf(stderr, "note: %s not found; benchmarking the default scene only\n", dragon.c_str());
   }
+  std::vector<Traversal> traversals;
+  for (const std::string& t : a.traversals) {
+    Traversal v = Traversal::Auto;
+    parseTraversal(t, v);
+    traversals.push_back(v);
+  }
   vk::Context ctx;
   vk::ContextOptions co;
   co.deviceIndex = a.device;
   vk::createContext(ctx, co);
-  std::printf("device: %s (%s), %u CPU threads\n", ctx.deviceName.c_str(), ctx.driverInfo.c_str(),
-              std::thread::hardware_concurrency());
-  std::printf("%-34s %9s %9s %5s %6s %8s %11s %8s %9s\n", "scene", "triangles", "size", "spp", "spp/pass", "seconds",
-              "samples/s", "Mrays/s", "CPU cores");
+  std::printf("device: %s (%s), %u CPU threads, %s\n", ctx.deviceName.c_str(), ctx.driverInfo.c_str(),
+              std::thread::hardware_concurrency(), ctx.rayQuery ? "ray queries" : "no ray queries");
+  std::printf("%-34s %9s %9s %9s %5s %6s %8s %11s %8s %9s %8s %9s\n", "scene", "triangles", "size", "traversal", "spp",
+              "spp/pass", "seconds", "samples/s", "Mrays/s", "CPU cores", "setup s", "warm-up s");
   for (const std::string& path : scenes) {
     Scene scene = loadSceneOrDefault(path, "");
     applyEnvironmentOptions(scene, a.env, false);
-    RenderSettings s;
-    s.width = a.width;
-    s.height = a.height;
-    s.spp = a.spp;
-    s.maxDepth = a.maxDepth;
-    s.samplesPerPass = a.samplesPerPass;
-    s.timeStages = true;
-    Renderer r(ctx, scene, s);
-    r.renderPass(1);  // warm-up: lavapipe compiles each pipeline at its first dispatch
-    const std::vector<std::pair<std::string, double>> warm = r.stageSeconds();
-    const std::vector<std::uint64_t> warmRays = r.raysPerBounce();
-    const RenderStats before = r.stats();
-    const double cpu0 = cpuSecondsUsed();
-    const auto t0 = std::chrono::steady_clock::now();
-    r.render(1 + a.spp);
-    const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const double cpu = cpuSecondsUsed() - cpu0;
-    const RenderStats after = r.stats();
-    const double rays = double(after.rays - before.rays + after.shadowRays - before.shadowRays);
-    const double samples = double(a.spp) * s.width * s.height;
-    char size[32];
-    std::snprintf(size, sizeof size, "%ux%u", s.width, s.height);
-    std::printf("%-34s %9zu %9s %5u %6u %8.3f %11.0f %8.3f %9.2f\n",
-                path.empty() ? "default (cornell-box)" : std::filesystem::path(path).filename().c_str(),
-                r.summary().triangles, size, a.spp, r.samplesPerPass(), sec, samples / sec, rays / sec / 1e6, cpu / sec);
-    double gpu = 0;
-    std::vector<std::pair<std::string, double>> timed;
-    for (auto& [name, t] : r.stageSeconds()) {
-      double w = 0;
-      for (auto& [n0, t0s] : warm)
-        if (n0 == name) w = t0s;
-      timed.push_back({name, t - w});
-      gpu += t - w;
-    }
-    if (gpu > 0) {
-      std::string stages, shades;
-      for (auto& [name, t] : timed) {
-        char buf[96];
-        const bool shade = name.rfind("shade ", 0) == 0;
-        std::snprintf(buf, sizeof buf, "%s%s %.1f%%", (shade ? shades : stages).empty() ? "" : ", ",
-                      shade ? name.c_str() + 6 : name.c_str(), 100.0 * t / gpu);
-        (shade ? shades : stages) += buf;
+    std::vector<std::vector<BenchRun>> runs(traversals.size());
+    for (std::uint32_t rep = 0; rep < a.repeats; ++rep)
+      for (std::size_t k = 0; k < traversals.size(); ++k)
+        runs[k].push_back(benchRenderOnce(ctx, scene, path, a, traversals[k]));
+    if (a.repeats > 1)
+      for (std::size_t k = 0; k < traversals.size(); ++k) {
+        const std::vector<BenchRun>& rs = runs[k];
+        std::printf("  %s, %s, median [min-max] of %u: %s samples/s, %s Mrays/s, %s CPU cores, setup %s s, warm-up %s s\n",
+                    path.empty() ? "default (cornell-box)" : std::filesystem::path(path).filename().c_str(),
+                    traversalName(resolveTraversal(ctx, traversals[k])), a.repeats,
+                    medianRange(rs, [](auto& r) { return r.samplesPerSecond; }, "%.0f").c_str(),
+                    medianRange(rs, [](auto& r) { return r.mraysPerSecond; }, "%.3f").c_str(),
+                    medianRange(rs, [](auto& r) { return r.cpuCores; }, "%.2f").c_str(),
+                    medianRange(rs, [](auto& r) { return r.setupSeconds; }, "%.3f").c_str(),
+                    medianRange(rs, [](auto& r) { return r.warmupSeconds; }, "%.3f").c_str());
       }
-      std::printf("    GPU time %.3f s by stage: %s\n", gpu, stages.c_str());
-      if (!shades.empty()) std::printf("    shade pipelines (model: share of GPU time): %s\n", shades.c_str());
-    }
-    std::string perBounce;
-    const std::vector<std::uint64_t>& bounces = r.raysPerBounce();
-    for (std::size_t b = 0; b < bounces.size(); ++b) {
-      const std::uint64_t n = bounces[b] - (b < warmRays.size() ? warmRays[b] : 0);
-      if (n == 0) continue;
-      char buf[48];
-      std::snprintf(buf, sizeof buf, "%s%zu:%.3g", perBounce.empty() ? "" : " ", b, double(n) / samples);
-      perBounce += buf;
-    }
-    std::printf("    paths per sample alive at bounce (bounce:fraction): %s\n", perBounce.c_str());
   }
   vk::destroyContext(ctx);
   return kExitOk;
@@ -543,6 +629,11 @@ int runCli(int argc, char** argv) {
                                                 "sample's luminance albedo; its survivors' saturated channels grow, "
                                                 "docs/performance.md)")
       ->capture_default_str()->check(CLI::IsMember(enumNames(kRouletteNames)));
+  render->add_option("--traversal", ra.traversal, "Ray traversal: rayquery (the device's ray queries against "
+                                                  "acceleration structures), bvh (the GLSL BVH, every device), auto "
+                                                  "(rayquery on a GPU that offers it, else bvh: on CPU devices such as "
+                                                  "lavapipe the BVH is faster, docs/performance.md)")
+      ->capture_default_str()->check(CLI::IsMember(enumNames(kTraversalNames)));
   render->add_option("--rng", ra.rng, "Random numbers: pcg (independent hashes) or qmc (padded Owen-scrambled Sobol)")
       ->capture_default_str()->check(CLI::IsMember(enumNames(kRngNames)));
   render->add_option("--checkpoint", ra.checkpointSeconds, "Write the image so far to the output every this many seconds "
@@ -570,6 +661,13 @@ int runCli(int argc, char** argv) {
                           "Samples per pixel per pass (0: chosen for the device, as render does)")
       ->capture_default_str()->check(CLI::Range(0u, 4096u));
   benchRender->add_option("--device", ba.device, "Vulkan device index");
+  benchRender->add_option("--traversal", ba.traversals, "Traversals to measure, interleaved within each repeat "
+                                                         "(auto, rayquery, bvh; comma-separated or repeated)")
+      ->capture_default_str()->delimiter(',')->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->check(CLI::IsMember(enumNames(kTraversalNames)));
+  benchRender->add_option("--repeats", ba.repeats, "Repeats of every scene and traversal; with more than one, the "
+                                                   "medians and ranges are printed")
+      ->capture_default_str()->check(CLI::Range(1u, 1000u));
   addEnvironmentOptions(*benchRender, ba.env);
 
   AlbedoArgs aa;

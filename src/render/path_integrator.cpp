@@ -126,9 +126,12 @@ void PathIntegrator::createPipelines() {
   const VkPipelineLayout layout = m_globals.layout();
   m_camera = vk::createComputePipeline(m_ctx, layout, "camera");
   m_submit = vk::createComputePipeline(m_ctx, layout, "submit");
-  m_intersect = vk::createComputePipeline(m_ctx, layout, "intersect");
+  // The tracing stages' module for the traversal (the Renderer resolved Auto): <stage>_rq with ray
+  // queries, <stage> with the GLSL BVH (CMakeLists.txt). Only the used one is compiled.
+  const std::string tracing = m_settings.traversal == Traversal::RayQuery ? "_rq" : "";
+  m_intersect = vk::createComputePipeline(m_ctx, layout, "intersect" + tracing);
   if (m_hasEscape) m_escape = vk::createComputePipeline(m_ctx, layout, "escape");
-  m_shadow = vk::createComputePipeline(m_ctx, layout, "shadow");
+  m_shadow = vk::createComputePipeline(m_ctx, layout, "shadow" + tracing);
   m_accumulate = vk::createComputePipeline(m_ctx, layout, "accumulate");
   // Only the models (and combinations) this scene uses: one specialised shade pipeline each,
   // created on all cores (drivers compile at creation; lavapipe takes ~0.3 s per shade pipeline,

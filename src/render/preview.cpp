@@ -87,6 +87,7 @@ struct PreviewArgs {
   std::string lighting = "mis";
   std::string sampler = "quadtree";
   std::string tonemap = "clamp";
+  std::string traversal = "auto";
   int device = -1;
   float exposure = 0.0f;
   std::uint32_t frames = 0;   // 0: until closed
@@ -682,6 +683,7 @@ int Preview::run() {
   m_settings.maxDepth = a.maxDepth;
   parseLighting(a.lighting, m_settings.lighting);
   parseSampler(a.sampler, m_settings.sampler);
+  parseTraversal(a.traversal, m_settings.traversal);
   m_settings.spp = 1;
   m_exposure = a.exposure;
   m_reinhard = a.tonemap == "reinhard";
@@ -703,6 +705,7 @@ int Preview::run() {
   co.validation = a.validation || validationFromEnvironment();
   for (std::uint32_t i = 0; i < extCount; ++i) co.instanceExtensions.push_back(exts[i]);
   co.swapchain = true;
+  co.rayQuery = m_settings.traversal != Traversal::Bvh;
   m_contextCreated = true;
   vk::createContext(m_ctx, co);
   VkResult sr = glfwCreateWindowSurface(m_ctx.instance, m_window, nullptr, &m_surface);
@@ -734,9 +737,10 @@ int Preview::run() {
     for (auto& m : sum.models) models += (models.empty() ? "" : ",") + m;
     std::fprintf(stderr, "scene: %s: %zu triangles, %zu materials (models: %s), %zu lights\n", m_scene.sourcePath.c_str(),
                  sum.triangles, sum.materials, models.c_str(), sum.lights);
-    std::fprintf(stderr, "device: %s; window %ux%u, max depth %u, seed %u, lighting %s, sampler %s; press H for the keys\n",
+    std::fprintf(stderr, "device: %s; window %ux%u, max depth %u, seed %u, lighting %s, sampler %s, traversal %s; press H "
+                         "for the keys\n",
                  m_ctx.deviceName.c_str(), m_settings.width, m_settings.height, m_settings.maxDepth, m_settings.seed,
-                 lightingModeName(m_settings.lighting), samplerName(m_settings.sampler));
+                 lightingModeName(m_settings.lighting), samplerName(m_settings.sampler), traversalName(sum.traversal));
   }
 
   std::unique_ptr<ScopedStopSignals> signals = std::make_unique<ScopedStopSignals>();
@@ -898,6 +902,8 @@ void registerPreviewCommand(CLI::App& app, CommandRunner& run) {
   p->add_option("--tonemap", a->tonemap, "Display tone map at start (T switches): clamp (as `render --png`), reinhard")
       ->capture_default_str()->check(CLI::IsMember({"clamp", "reinhard"}));
   p->add_option("--device", a->device, "Vulkan device index (see `nusselt devices`)");
+  p->add_option("--traversal", a->traversal, "Ray traversal: rayquery, bvh or auto (as `render --traversal`)")
+      ->capture_default_str()->check(CLI::IsMember(enumNames(kTraversalNames)));
   p->add_option("--frames", a->frames, "Exit after presenting this many frames, or earlier when --max-spp is reached (scripts and tests; 0: run until closed)")
       ->capture_default_str();
   p->add_option("--max-spp", a->maxSpp, "Stop accumulating at this many samples per pixel and idle (0: no limit)")

@@ -21,6 +21,8 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
 RenderLoop::RenderLoop(Renderer& renderer, RenderRecord base, const RenderRecord& previous, RenderLoopOptions options)
     : m_renderer(renderer), m_base(std::move(base)), m_previous(previous), m_options(std::move(options)) {
   m_start = m_lastCheckpoint = std::chrono::steady_clock::now();
+  // The record names the traversal that ran (the renderer resolved auto).
+  m_base.settings.traversal = m_renderer.settings().traversal;
   if (m_options.progress) {
     const RenderSettings& s = m_renderer.settings();
     m_progress = std::make_unique<Progress>("render", m_options.spp, std::uint64_t(s.width) * s.height, false,

@@ -80,6 +80,7 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
                   {"nusselt/rng", rngModeName(r.settings.rng)},
                   {"nusselt/sampler", samplerName(r.settings.sampler)},
                   {"nusselt/components", componentSelectionName(r.settings.components)},
+                  {"nusselt/traversal", traversalName(r.settings.traversal)},
                   {"nusselt/models", r.models},
                   {"nusselt/camera", cameraText(r.camera)},
                   {"nusselt/environment", r.environment},
@@ -129,6 +130,10 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   // Absent in files written before combined materials existed: those rendered in albedo mode.
   if (!parseComponentSelection(findString(meta, "nusselt/components").value_or("albedo"), r.settings.components))
     throw Error(path + ": header attribute nusselt/components names an unknown component selection");
+  // Absent in files written before ray queries existed: those traced with the BVH. Not compared by
+  // firstDifference: both traversals estimate the same image (their hits differ in float rounding).
+  if (!parseTraversal(findString(meta, "nusselt/traversal").value_or("bvh"), r.settings.traversal))
+    throw Error(path + ": header attribute nusselt/traversal names an unknown traversal");
   // Absent in files written before the throughput roulette existed: those used the albedo roulette.
   if (!parseRouletteMode(findString(meta, "nusselt/roulette").value_or("albedo"), r.settings.roulette))
     throw Error(path + ": header attribute nusselt/roulette names an unknown roulette");

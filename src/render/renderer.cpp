@@ -39,9 +39,20 @@ glm::vec4 v4(glm::vec3 v, float w = 0.0f) { return glm::vec4(v, w); }
 
 }  // namespace
 
+Traversal resolveTraversal(const vk::Context& ctx, Traversal requested) {
+  if (requested == Traversal::Auto)
+    return ctx.rayQuery && ctx.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU ? Traversal::RayQuery : Traversal::Bvh;
+  if (requested == Traversal::RayQuery && !ctx.rayQuery)
+    throw Error("--traversal rayquery: " + ctx.deviceName + " (" + ctx.driverInfo + ") does not offer ray queries "
+                "(VK_KHR_ray_query with VK_KHR_acceleration_structure); use --traversal bvh or auto");
+  return requested;
+}
+
 Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& settings)
     : m_ctx(ctx), m_settings(settings) {
   if (settings.width == 0 || settings.height == 0) throw Error("image size must be at least 1x1");
+  m_settings.traversal = resolveTraversal(ctx, settings.traversal);
+  m_summary.traversal = m_settings.traversal;
   const std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;
   if (pixels > (1ull << 28)) throw Error("image too large: at most 2^28 pixels");
   m_summary.triangles = scene.triangleCount();
@@ -61,7 +72,8 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
       throw Error("environment map '" + scene.environment.path + "' (" + std::to_string(scene.environment.width) + "x" +
                   std::to_string(scene.environment.height) + ") needs " + mib(envBytes) + " of device memory, more than " +
                   m_ctx.deviceName + " allows in one allocation (" + mib(m_ctx.maxAllocation) + "): use a smaller map");
-    const std::uint64_t need = DeviceScene::bytesFor(scene.triangleCount(), lightBound + 1) + envBytes +
+    const std::uint64_t need = DeviceScene::bytesFor(scene.triangleCount(), lightBound + 1,
+                                                     m_settings.traversal == Traversal::RayQuery) + envBytes +
                                std::max<std::size_t>(scene.materials.size(), 1) * sizeof(shared::GpuMaterial) +
                                Film::bytesFor(pixels) + PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS);
     const std::uint64_t have = vk::deviceLocalHeapSize(m_ctx);
@@ -78,10 +90,15 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   }
 
   m_globals = std::make_unique<StageGlobals>(m_ctx, STAGE_PUSH_BYTES);
-  m_scene = std::make_unique<DeviceScene>(m_ctx, scene);
+  TraversalStructures structures;
+  structures.bvh = m_settings.traversal == Traversal::Bvh;
+  structures.accelerationStructures = m_settings.traversal == Traversal::RayQuery;
+  m_scene = std::make_unique<DeviceScene>(m_ctx, scene, structures);
   m_summary.lights = m_scene->lights();
   m_summary.bvhSeconds = m_scene->bvhSeconds();
   m_summary.bvhNodes = m_scene->bvhNodes();
+  m_summary.accelerationSeconds = m_scene->accelerationSeconds();
+  m_summary.accelerationBytes = m_scene->accelerationBytes();
   m_materials = std::make_unique<MaterialTable>(m_ctx, scene, settings);
   m_summary.models = m_materials->slotNames();
   const SamplerPlanSummary& plan = m_materials->samplerPlan();
@@ -106,7 +123,7 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   m_camera = scene.hasCamera ? scene.camera : frameScene(scene);
   writeCamera(m_camera);
 
-  auto integrator = std::make_unique<PathIntegrator>(m_ctx, *m_globals, settings, m_materials->slotKeys(), pixels,
+  auto integrator = std::make_unique<PathIntegrator>(m_ctx, *m_globals, m_settings, m_materials->slotKeys(), pixels,
                                                      m_samplesPerPass, m_materials->slotNames());
   m_summary.pipelineSeconds = integrator->pipelineSeconds();
   m_integrator = std::move(integrator);

@@ -1,5 +1,5 @@
 // renderer.h: one render of one scene on one device, put together from its parts:
-//   DeviceScene    triangles, BVH, lights (device_scene.h)
+//   DeviceScene    triangles, BVH or acceleration structures, lights (device_scene.h)
 //   MaterialTable  shade slots, GPU materials and the sampling plan (material_table.h)
 //   Film           the accumulated image (film.h)
 //   Integrator     the wavefront path tracer (path_integrator.h); others sit beside it
@@ -27,8 +27,11 @@ struct SceneSummary {
   std::size_t materials = 0;
   std::size_t lights = 0;
   std::vector<std::string> models;  // models the render's shade stages contain ("a+b": combined)
-  double bvhSeconds = 0;
+  Traversal traversal = Traversal::Bvh;  // what traces the rays (never Auto here)
+  double bvhSeconds = 0;                 // 0 and no nodes when ray queries trace
   std::uint32_t bvhNodes = 0;
+  double accelerationSeconds = 0;        // acceleration structure builds (ray queries only)
+  std::uint64_t accelerationBytes = 0;
   double pipelineSeconds = 0;       // creating the pipelines (lavapipe compiles at first dispatch)
   double samplerSeconds = 0;        // building (or loading) the quadtrees
   std::uint32_t samplerTrees = 0;
@@ -37,10 +40,18 @@ struct SceneSummary {
   std::uint64_t deviceBytes = 0;
 };
 
+// The traversal a render with `requested` uses on this context. Auto: ray queries where the
+// device offers them and is a GPU; the GLSL BVH on CPU devices (lavapipe runs its ray-query
+// traversal as shader code, and there the GLSL BVH measured 1.8-3x faster: docs/performance.md)
+// and on devices without ray queries. Throws nusselt::Error for RayQuery on a context without them.
+Traversal resolveTraversal(const vk::Context& ctx, Traversal requested);
+
 class Renderer {
  public:
   // Throws nusselt::Error (naming what does not fit) for an empty or too large image, a render
-  // that does not fit the device's memory, or a scene the material table refuses.
+  // that does not fit the device's memory, a scene the material table refuses, or
+  // Traversal::RayQuery on a context without ray queries. settings().traversal is the traversal
+  // used (resolveTraversal).
   Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& settings);
   ~Renderer();
   Renderer(const Renderer&) = delete;

@@ -83,6 +83,14 @@ enum class RouletteMode : std::uint32_t { Throughput = ROULETTE_THROUGHPUT, Albe
 inline constexpr EnumName<RouletteMode> kRouletteNames[] = {{RouletteMode::Throughput, "throughput"},
                                                             {RouletteMode::Albedo, "albedo"}};
 
+// Scene traversal of the intersect and shadow stages (shaders/shared/trace.glsl): rayquery = the
+// device's ray queries against acceleration structures, bvh = the GLSL BVH (every device), auto =
+// rayquery on a GPU that offers it, else bvh (resolveTraversal, renderer.h). Not a shader value:
+// it selects the stages' modules.
+enum class Traversal : std::uint32_t { Auto, RayQuery, Bvh };
+inline constexpr EnumName<Traversal> kTraversalNames[] = {
+    {Traversal::Auto, "auto"}, {Traversal::RayQuery, "rayquery"}, {Traversal::Bvh, "bvh"}};
+
 inline const char* lightingModeName(LightingMode m) { return enumName(kLightingNames, m); }
 inline const char* samplerName(SamplerKind k) { return enumName(kSamplerNames, k); }
 inline const char* rngModeName(RngMode m) { return enumName(kRngNames, m); }
@@ -95,6 +103,8 @@ inline bool parseComponentSelection(const std::string& name, ComponentSelection&
   return parseEnum(kComponentNames, name, m);
 }
 inline bool parseRouletteMode(const std::string& name, RouletteMode& m) { return parseEnum(kRouletteNames, name, m); }
+inline const char* traversalName(Traversal t) { return enumName(kTraversalNames, t); }
+inline bool parseTraversal(const std::string& name, Traversal& t) { return parseEnum(kTraversalNames, name, t); }
 
 struct RenderSettings {
   std::uint32_t width = 512;
@@ -107,6 +117,8 @@ struct RenderSettings {
   SamplerKind sampler = SamplerKind::Quadtree;  // the generic sampler of Montes et al.
   ComponentSelection components = ComponentSelection::Albedo;  // combined materials only
   RouletteMode roulette = RouletteMode::Throughput;
+  // The Renderer resolves Auto to what it uses (Renderer::settings().traversal).
+  Traversal traversal = Traversal::Auto;
   // The quadtree sampler's table counts (quadtree::QuadtreeSettings; the paper's 90 and 16 by
   // default; phi only for anisotropic sets). Fewer tables build faster (the hard-case tests use
   // 90 x 4 for the anisotropic hard sets) at the cost of a coarser grid in the outgoing direction:

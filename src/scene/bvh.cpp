@@ -501,4 +501,38 @@ bool bvhClosestHit(const Bvh& bvh, const std::vector<glm::vec3>& positions, glm:
   return found;
 }
 
+std::vector<std::uint32_t> mortonOrder(const std::vector<glm::vec3>& positions) {
+  const std::size_t n = positions.size() / 3;
+  glm::vec3 lo(INFINITY), hi(-INFINITY);
+  std::vector<glm::vec3> centroid(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    centroid[i] = (positions[3 * i] + positions[3 * i + 1] + positions[3 * i + 2]) / 3.0f;
+    lo = glm::min(lo, centroid[i]);
+    hi = glm::max(hi, centroid[i]);
+  }
+  // Spread the 10 low bits of v to every third bit.
+  auto spread = [](std::uint32_t v) {
+    v = (v | (v << 16)) & 0x030000ffu;
+    v = (v | (v << 8)) & 0x0300f00fu;
+    v = (v | (v << 4)) & 0x030c30c3u;
+    v = (v | (v << 2)) & 0x09249249u;
+    return v;
+  };
+  const glm::vec3 extent = hi - lo;
+  std::vector<std::uint64_t> keyed(n);  // code in the high 32 bits, index in the low: one sort, ties by index
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint32_t q[3];
+    for (int a = 0; a < 3; ++a) {
+      float f = extent[a] > 0.0f ? (centroid[i][a] - lo[a]) / extent[a] : 0.0f;
+      q[a] = static_cast<std::uint32_t>(std::min(std::max(f, 0.0f), 1.0f) * 1023.0f);
+    }
+    std::uint32_t code = (spread(q[0]) << 2) | (spread(q[1]) << 1) | spread(q[2]);
+    keyed[i] = (std::uint64_t(code) << 32) | i;
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::uint32_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(keyed[i]);
+  return order;
+}
+
 }  // namespace nusselt

@@ -54,6 +54,13 @@ struct Bvh {
 // several threads. The result does not depend on the number of threads.
 Bvh buildBvh(const std::vector<glm::vec3>& positions);
 
+// The triangles (3 positions each) sorted along a Morton curve of their centroids (10 bits per
+// axis over the bounding box of the centroids; ties keep their order): position i holds original
+// triangle order[i]. A spatially coherent order for builders that split the primitives in the
+// order given (Mesa 25.0's lavapipe builds its acceleration structures by halving the primitive
+// range), and for the locality of per-triangle data. Linear-time codes plus one sort.
+std::vector<std::uint32_t> mortonOrder(const std::vector<glm::vec3>& positions);
+
 // ---- Reference traversal (tests only) -----------------------------------------------------------
 // The C++ twin of traceClosest in bvh_traverse.glsl: same slab test, same Moller-Trumbore, same
 // stack discipline. positions are the ORIGINAL (not reordered) positions given to buildBvh; tri

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 #include "util/error.h"
@@ -184,6 +185,7 @@ DeviceInfo describe(VkPhysicalDevice pd, std::uint32_t index, std::uint32_t* que
     return info;
   }
   info.suitable = true;
+  info.rayQuery = rayQueryUsable(pd);
   return info;
 }
 
@@ -199,7 +201,32 @@ std::string formatBytes(VkDeviceSize bytes) {
   return buf;
 }
 
+bool hasDeviceExtension(const std::vector<VkExtensionProperties>& all, const char* name) {
+  for (const VkExtensionProperties& e : all)
+    if (std::strcmp(e.extensionName, name) == 0) return true;
+  return false;
+}
+
 }  // namespace
+
+bool rayQueryUsable(VkPhysicalDevice pd) {
+  const char* fault = std::getenv("NUSSELT_FAULT_NO_RAY_QUERY");
+  if (fault && *fault && std::strcmp(fault, "0") != 0) return false;
+  std::uint32_t n = 0;
+  vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, nullptr);
+  std::vector<VkExtensionProperties> all(n);
+  vkEnumerateDeviceExtensionProperties(pd, nullptr, &n, all.data());
+  for (const char* e : {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME, VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                        VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME})
+    if (!hasDeviceExtension(all, e)) return false;
+  VkPhysicalDeviceRayQueryFeaturesKHR rq{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR as{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  as.pNext = &rq;
+  VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  f2.pNext = &as;
+  vkGetPhysicalDeviceFeatures2(pd, &f2);
+  return as.accelerationStructure && rq.rayQuery;
+}
 
 const char* resultName(VkResult r) {
   switch (r) {
@@ -309,6 +336,29 @@ void createContext(Context& ctx, const ContextOptions& options) {
   f2.pNext = &f12;
   std::vector<const char*> extensions;
   if (options.swapchain) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+  // Ray queries only where offered (Mesa 25's lavapipe and current GPU drivers; not Mesa 22.3):
+  // otherwise the device is created as before and the GLSL BVH traces every ray. Acceleration
+  // structure builds take scratch and instance buffers by device address (bufferDeviceAddress,
+  // enabled above for every device).
+  VkPhysicalDeviceAccelerationStructureFeaturesKHR asFeatures{
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR};
+  VkPhysicalDeviceRayQueryFeaturesKHR rqFeatures{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+  ctx.rayQuery = options.rayQuery && rayQueryUsable(ctx.physical);
+  if (ctx.rayQuery) {
+    extensions.push_back(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
+    extensions.push_back(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
+    extensions.push_back(VK_KHR_RAY_QUERY_EXTENSION_NAME);
+    asFeatures.accelerationStructure = VK_TRUE;
+    rqFeatures.rayQuery = VK_TRUE;
+    asFeatures.pNext = &rqFeatures;
+    f12.pNext = &asFeatures;
+    VkPhysicalDeviceAccelerationStructurePropertiesKHR asProps{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR};
+    VkPhysicalDeviceProperties2 p2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2};
+    p2.pNext = &asProps;
+    vkGetPhysicalDeviceProperties2(ctx.physical, &p2);
+    ctx.asScratchAlignment = std::max<VkDeviceSize>(asProps.minAccelerationStructureScratchOffsetAlignment, 1);
+  }
   VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
   dci.pNext = &f2;
   dci.queueCreateInfoCount = 1;
@@ -397,6 +447,138 @@ void destroyBuffer(Context& ctx, Buffer& b) {
   if (b.buffer) vkDestroyBuffer(ctx.device, b.buffer, nullptr);
   if (b.memory) vkFreeMemory(ctx.device, b.memory, nullptr);
   b = Buffer{};
+}
+
+namespace {
+
+// Creates the structure's buffer (device-local, with a device address) and handle for `size`
+// bytes. `what` names it in out-of-memory errors.
+AccelerationStructure createAccelerationStructure(Context& ctx, VkAccelerationStructureTypeKHR type, VkDeviceSize size,
+                                                  const std::string& what) {
+  AccelerationStructure as;
+  as.buffer = createBuffer(ctx, size, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR, false, what);
+  VkAccelerationStructureCreateInfoKHR ci{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
+  ci.buffer = as.buffer.buffer;
+  ci.size = size;
+  ci.type = type;
+  VkResult r = vkCreateAccelerationStructureKHR(ctx.device, &ci, nullptr, &as.handle);
+  if (r != VK_SUCCESS) {
+    destroyBuffer(ctx, as.buffer);
+    throw Error("cannot create the " + what + " (" + formatBytes(size) + "): " + resultName(r));
+  }
+  VkAccelerationStructureDeviceAddressInfoKHR ai{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR};
+  ai.accelerationStructure = as.handle;
+  as.address = vkGetAccelerationStructureDeviceAddressKHR(ctx.device, &ai);
+  return as;
+}
+
+// Sizes, allocation and the build of one structure from one geometry; waits for it. The scratch
+// buffer is padded by the device's scratch alignment so that an aligned address lies inside it.
+AccelerationStructure buildOne(Context& ctx, VkAccelerationStructureTypeKHR type,
+                               const VkAccelerationStructureGeometryKHR& geometry, std::uint32_t primitives,
+                               const std::string& what) {
+  VkAccelerationStructureBuildGeometryInfoKHR build{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR};
+  build.type = type;
+  // Built once per scene and traced billions of times: trace speed over build speed.
+  build.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+  build.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  build.geometryCount = 1;
+  build.pGeometries = &geometry;
+  VkAccelerationStructureBuildSizesInfoKHR sizes{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR};
+  vkGetAccelerationStructureBuildSizesKHR(ctx.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &build,
+                                          &primitives, &sizes);
+  AccelerationStructure as = createAccelerationStructure(ctx, type, sizes.accelerationStructureSize, what);
+  Buffer scratch;
+  try {
+    scratch = createBuffer(ctx, sizes.buildScratchSize + ctx.asScratchAlignment, 0, false, what + " build scratch");
+  } catch (...) {
+    destroyAccelerationStructure(ctx, as);
+    throw;
+  }
+  const VkDeviceSize align = ctx.asScratchAlignment ? ctx.asScratchAlignment : 1;
+  build.dstAccelerationStructure = as.handle;
+  build.scratchData.deviceAddress = (scratch.address + align - 1) / align * align;
+  VkAccelerationStructureBuildRangeInfoKHR range{primitives, 0, 0, 0};
+  const VkAccelerationStructureBuildRangeInfoKHR* ranges = &range;
+  VkCommandBuffer cmd = beginOneShot(ctx);
+  // The inputs were uploaded by earlier copies (vertices, instances) or built by an earlier build
+  // (the bottom level under a top level): make them visible to this build.
+  VkMemoryBarrier before{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  before.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
+  before.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
+                       VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, 0, 1, &before, 0, nullptr, 0, nullptr);
+  vkCmdBuildAccelerationStructuresKHR(cmd, 1, &build, &ranges);
+  // The structure is read by later builds and by the compute stages' ray queries (later
+  // submissions: a barrier's second scope extends to them in submission order).
+  VkMemoryBarrier after{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  after.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
+  after.dstAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
+                       VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0,
+                       1, &after, 0, nullptr, 0, nullptr);
+  try {
+    endOneShot(ctx, cmd);
+  } catch (...) {
+    destroyBuffer(ctx, scratch);
+    destroyAccelerationStructure(ctx, as);
+    throw;
+  }
+  destroyBuffer(ctx, scratch);
+  return as;
+}
+
+}  // namespace
+
+AccelerationStructure buildBottomLevel(Context& ctx, const Buffer& vertices, std::uint32_t triangles) {
+  VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+  geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+  // Opaque: no candidate is handed to the shader, the traversal commits the closest hit itself.
+  geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+  VkAccelerationStructureGeometryTrianglesDataKHR& tri = geometry.geometry.triangles;
+  tri.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR;
+  tri.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+  tri.vertexData.deviceAddress = vertices.address;
+  tri.vertexStride = 3 * sizeof(float);
+  tri.maxVertex = triangles * 3 - 1;
+  tri.indexType = VK_INDEX_TYPE_NONE_KHR;
+  return buildOne(ctx, VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, geometry, triangles,
+                  "bottom-level acceleration structure");
+}
+
+AccelerationStructure buildTopLevel(Context& ctx, const AccelerationStructure& bottom) {
+  VkAccelerationStructureInstanceKHR instance{};
+  instance.transform.matrix[0][0] = instance.transform.matrix[1][1] = instance.transform.matrix[2][2] = 1.0f;
+  instance.instanceCustomIndex = 0;
+  instance.mask = 0xff;
+  instance.instanceShaderBindingTableRecordOffset = 0;
+  instance.flags = VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR;
+  instance.accelerationStructureReference = bottom.address;
+  Buffer instances = createBuffer(ctx, sizeof instance,
+                                  VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR, false,
+                                  "acceleration structure instance");
+  AccelerationStructure as;
+  try {
+    uploadBuffer(ctx, instances, &instance, sizeof instance);
+    VkAccelerationStructureGeometryKHR geometry{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR};
+    geometry.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
+    geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+    geometry.geometry.instances.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR;
+    geometry.geometry.instances.arrayOfPointers = VK_FALSE;
+    geometry.geometry.instances.data.deviceAddress = instances.address;
+    as = buildOne(ctx, VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, geometry, 1, "top-level acceleration structure");
+  } catch (...) {
+    destroyBuffer(ctx, instances);
+    throw;
+  }
+  destroyBuffer(ctx, instances);
+  return as;
+}
+
+void destroyAccelerationStructure(Context& ctx, AccelerationStructure& as) {
+  if (as.handle) vkDestroyAccelerationStructureKHR(ctx.device, as.handle, nullptr);
+  destroyBuffer(ctx, as.buffer);
+  as = AccelerationStructure{};
 }
 
 VkCommandBuffer beginOneShot(Context& ctx) {

@@ -25,6 +25,7 @@ struct DeviceInfo {
   bool suitable = false;
   std::string whyNot;  // when not suitable
   std::uint64_t deviceLocalBytes = 0;
+  bool rayQuery = false;  // offers VK_KHR_ray_query and VK_KHR_acceleration_structure (rayQueryUsable)
 };
 
 struct ContextOptions {
@@ -32,6 +33,7 @@ struct ContextOptions {
   bool validation = false;    // VK_LAYER_KHRONOS_validation with synchronization validation
   std::vector<std::string> instanceExtensions;  // e.g. surface extensions for the preview
   bool swapchain = false;     // enable VK_KHR_swapchain on the device
+  bool rayQuery = true;       // enable ray queries when the device offers them (Context::rayQuery)
 };
 
 struct Context {
@@ -47,10 +49,20 @@ struct Context {
   std::string deviceName;
   std::string driverInfo;         // e.g. "llvmpipe Mesa 25.0.7 (LLVM 15.0.6)": driver name and version
   VkDeviceSize maxAllocation = 0; // largest single memory allocation (maxMemoryAllocationSize)
+  // Ray queries are enabled (VK_KHR_ray_query, VK_KHR_acceleration_structure): the device offers
+  // them and ContextOptions::rayQuery asked for them. Otherwise the GLSL BVH traces all rays.
+  bool rayQuery = false;
+  VkDeviceSize asScratchAlignment = 0;  // minAccelerationStructureScratchOffsetAlignment
   bool validation = false;
   // Validation messages (warnings and errors) seen so far; tests require zero.
   std::atomic<std::uint64_t> validationMessages{0};
 };
+
+// Whether a device offers hardware ray queries: the extensions VK_KHR_acceleration_structure (with
+// VK_KHR_deferred_host_operations, which it requires) and VK_KHR_ray_query and their features
+// accelerationStructure and rayQuery. NUSSELT_FAULT_NO_RAY_QUERY=1 makes every device answer no
+// (tests of the fallback on machines whose driver has them).
+bool rayQueryUsable(VkPhysicalDevice device);
 
 // Lists the devices with why each one is or is not usable. Throws when there is no loader.
 std::vector<DeviceInfo> listDevices();
@@ -78,6 +90,24 @@ VkDeviceSize deviceLocalHeapSize(const Context& ctx);
 // Copies bytes into a buffer (through a staging buffer when it is not host visible).
 void uploadBuffer(Context& ctx, Buffer& buffer, const void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
 void downloadBuffer(Context& ctx, const Buffer& buffer, void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
+
+// An acceleration structure and the buffer that holds it (ray queries only).
+struct AccelerationStructure {
+  VkAccelerationStructureKHR handle = VK_NULL_HANDLE;
+  Buffer buffer;
+  VkDeviceAddress address = 0;  // vkGetAccelerationStructureDeviceAddressKHR
+};
+// Builds a bottom-level structure over `triangles` non-indexed triangles whose vertices (three
+// floats each, three vertices per triangle) are at `vertices`, a buffer created with
+// VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR. Primitive i is triangle i;
+// the geometry is opaque (no any-hit shaders: closest hits need no candidate loop). Waits for the
+// build. Throws nusselt::Error naming the buffer that does not fit.
+AccelerationStructure buildBottomLevel(Context& ctx, const Buffer& vertices, std::uint32_t triangles);
+// Builds a top-level structure holding one instance of `bottom` with the identity transform,
+// instance index 0, mask 0xff and face culling disabled (both faces hit, as the BVH's
+// Moller-Trumbore test). Waits for the build.
+AccelerationStructure buildTopLevel(Context& ctx, const AccelerationStructure& bottom);
+void destroyAccelerationStructure(Context& ctx, AccelerationStructure& as);
 
 // One-shot command buffer: begin, record in `record`, submit and wait.
 VkCommandBuffer beginOneShot(Context& ctx);

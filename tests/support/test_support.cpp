@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "scene/gltf_loader.h"
+#include "util/error.h"
 
 namespace nusselt::test {
 
@@ -67,8 +68,14 @@ void addQuad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::
 }
 
 Rendered render(const Scene& scene, const RenderSettings& settings) {
-  Renderer r(context(), scene, settings);
-  r.render(settings.spp);
+  // NUSSELT_TEST_TRAVERSAL=rayquery|bvh runs the renders that leave the traversal at auto with
+  // that one (the render suite under both traversals: README, Tests).
+  RenderSettings s = settings;
+  const char* forced = std::getenv("NUSSELT_TEST_TRAVERSAL");
+  if (forced && *forced && s.traversal == Traversal::Auto && !parseTraversal(forced, s.traversal))
+    throw Error(std::string("NUSSELT_TEST_TRAVERSAL=") + forced + ": not auto, rayquery or bvh");
+  Renderer r(context(), scene, s);
+  r.render(s.spp);
   return {r.image(true), r.stats(), r.summary()};
 }
 

@@ -27,6 +27,8 @@ struct Rendered {
   RenderStats stats;
   SceneSummary summary;  // pipeline and quadtree build times, cache hits
 };
+// Renders settings.spp passes. A traversal left at auto is replaced by NUSSELT_TEST_TRAVERSAL
+// (rayquery or bvh) when that is set.
 Rendered render(const Scene& scene, const RenderSettings& settings);
 
 // Runs an embedded standalone compute kernel (one that declares its own push-constant block of at

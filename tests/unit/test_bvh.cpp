@@ -392,6 +392,32 @@ constexpr bool kSanitized = false;
 constexpr bool kSanitized = false;
 #endif
 
+// mortonOrder (the triangle order handed to acceleration-structure builders): a permutation; on
+// triangles whose centroids lie on a line in shuffled order, the order along the line (a Morton
+// curve restricted to one axis is monotonic); an empty scene gives an empty order.
+TEST(Bvh, MortonOrder) {
+  auto p = randomSoup(5000, 0.01f, 7u);
+  std::vector<std::uint32_t> order = mortonOrder(p);
+  ASSERT_EQ(order.size(), 5000u);
+  std::vector<bool> seen(5000, false);
+  for (std::uint32_t i : order) {
+    ASSERT_LT(i, 5000u);
+    EXPECT_FALSE(seen[i]) << "triangle " << i << " twice";
+    seen[i] = true;
+  }
+  std::vector<std::uint32_t> slot(1000);
+  for (std::uint32_t i = 0; i < 1000; ++i) slot[i] = (i * 617u) % 1000u;  // 617 is prime to 1000: a shuffle
+  std::vector<glm::vec3> line;
+  for (std::uint32_t i = 0; i < 1000; ++i) {
+    float x = float(slot[i]);
+    line.insert(line.end(), {glm::vec3(x, 0, 0), glm::vec3(x + 0.1f, 1, 0), glm::vec3(x + 0.2f, 0, 1)});
+  }
+  order = mortonOrder(line);
+  ASSERT_EQ(order.size(), 1000u);
+  for (std::uint32_t k = 1; k < 1000; ++k) EXPECT_LE(slot[order[k - 1]], slot[order[k]]) << "at " << k;
+  EXPECT_TRUE(mortonOrder({}).empty());
+}
+
 // Build times (printed, not asserted: the machine running the tests varies).
 TEST(Bvh, BuildTimes) {
   for (std::uint32_t n : {100000u, 1000000u}) {
