@@ -6,6 +6,8 @@
 #include <cmath>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "brdf/albedo.h"
 #include "util/error.h"
 
@@ -443,11 +445,41 @@ BrdfParams packParams(const ModelSpec& model, const NamedParams& values, const s
   return p;
 }
 
+namespace {
+
+// A JSON value of a --param argument as a ParamValue: numbers, strings and arrays of them (the
+// NUSSELT_brdf extension's syntax); anything else is refused.
+ParamValue fromJson(const nlohmann::json& j, const std::string& argument) {
+  if (j.is_number()) return ParamValue::num(j.get<double>());
+  if (j.is_string()) return ParamValue::str(j.get<std::string>());
+  if (j.is_array()) {
+    std::vector<ParamValue> items;
+    for (const nlohmann::json& e : j) items.push_back(fromJson(e, argument));
+    return arrayValue(std::move(items));
+  }
+  throw Error("--param \"" + argument + "\": only numbers, strings and arrays of them are allowed");
+}
+
+}  // namespace
+
 std::pair<std::string, ParamValue> parseParamArgument(const std::string& argument) {
   auto eq = argument.find('=');
   if (eq == std::string::npos || eq == 0)
-    throw Error("--param \"" + argument + "\": expected name=value or name=r,g,b");
+    throw Error("--param \"" + argument + "\": expected name=value, name=r,g,b or name=[JSON array]");
   std::string name = argument.substr(0, eq), rest = argument.substr(eq + 1);
+  if (!rest.empty() && rest[0] == '[') {
+    // The extension's JSON, e.g. lobes=[[-1.03,-1.03,1.03,20]]. Nesting is capped before parsing
+    // (no parameter nests deeper than 2; the recursion of the parser and of fromJson stays small).
+    int depth = 0, deepest = 0;
+    for (char c : rest) {
+      if (c == '[') deepest = std::max(deepest, ++depth);
+      else if (c == ']') --depth;
+    }
+    if (deepest > 4) throw Error("--param \"" + argument + "\": arrays nest at most 4 deep");
+    nlohmann::json j = nlohmann::json::parse(rest, nullptr, false);
+    if (j.is_discarded()) throw Error("--param \"" + argument + "\": the value after '=' is not valid JSON");
+    return {name, fromJson(j, argument)};
+  }
   std::vector<ParamValue> parts;
   std::stringstream ss(rest);
   std::string item;

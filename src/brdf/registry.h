@@ -91,7 +91,8 @@ BrdfParams packParams(const ModelSpec& model, const NamedParams& values, const s
 const NamedParams& typicalParams(const ModelSpec& model);
 const NamedParams& hardParams(const ModelSpec& model);
 
-// "name=value" or "name=r,g,b" from the command line.
+// "name=value", "name=r,g,b" or "name=[JSON array]" (the NUSSELT_brdf syntax, e.g.
+// lobes=[[-1.03,-1.03,1.03,20]]) from the command line.
 std::pair<std::string, ParamValue> parseParamArgument(const std::string& argument);
 
 // Human-readable allowed range of a parameter, e.g. "[0, 1]" or "one of ward92, duer, gmd".

@@ -674,7 +674,7 @@ int runCli(int argc, char** argv) {
   CLI::App* albedo = app.add_subcommand("albedo", "Directional albedo of a reflectance model (cosine-weighted integral of its "
                                                   "luminance over the hemisphere), to at least 6 significant digits");
   albedo->add_option("--model", aa.model, "Model name (docs/models.md)")->required();
-  albedo->add_option("--param", aa.params, "name=value or name=r,g,b (repeatable); others take their defaults");
+  albedo->add_option("--param", aa.params, "name=value, name=r,g,b or name=[JSON] as in NUSSELT_brdf (lafortune: lobes=[[Cx,Cy,Cz,n],...]); repeatable; others take their defaults");
   albedo->add_option("--file", aa.file, "Measured models (merl): the MERL binary file (docs/measured.md)");
   albedo->add_option("--set", aa.set, "Start from the catalogue's typical or hard parameter set")
       ->check(CLI::IsMember({"typical", "hard"}));

@@ -336,7 +336,7 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
   auto sa = std::make_shared<SampleArgs>();
   CLI::App* sample = app.add_subcommand("sample", "Draw directions with a BSDF sampling strategy (default: the generic quadtree sampler; CSV: x,y,z,pdf,f)");
   sample->add_option("--model", sa->model, "Reflectance model")->required();
-  sample->add_option("--param", sa->params, "name=value (repeatable); overrides the preset");
+  sample->add_option("--param", sa->params, "name=value, name=r,g,b or name=[JSON] as in NUSSELT_brdf (repeatable); overrides the preset");
   sample->add_option("--file", sa->file, "Measured models (merl): the MERL binary file (docs/measured.md)");
   sample->add_option("--preset", sa->preset, "Parameter set: typical (default) or hard")->check(CLI::IsMember({"typical", "hard"}));
   sample->add_option("--theta", sa->thetaDeg, "Polar angle of the known direction (sin t cos p, sin t sin p, cos t), degrees")->required();
