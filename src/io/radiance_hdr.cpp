@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 
 #include "util/error.h"
 
@@ -106,7 +107,6 @@ RgbeImage decodeRadianceHdr(const std::uint8_t* data, std::size_t size, const st
   // Rows are added as they are decoded: a header that claims a huge image in a short file fails
   // at its first missing byte, not after allocating the whole image.
   std::vector<std::uint8_t> scan(std::size_t(4) * w);
-  const float inv = float(1.0 / exposure);
 
   for (long y = 0; y < h; ++y) {
     // New-style run-length encoding: 2, 2, width (big-endian, < 32768), then each of the four
@@ -163,7 +163,14 @@ RgbeImage decodeRadianceHdr(const std::uint8_t* data, std::size_t size, const st
     for (long x = 0; x < w; ++x) {
       rgbeToFloat(&scan[4 * x], row + 3 * x);
       if (exposure != 1.0)
-        for (int k = 0; k < 3; ++k) row[3 * x + k] *= inv;
+        for (int k = 0; k < 3; ++k) {
+          // In double: a tiny EXPOSURE can make 1 / exposure overflow a float, and 0 x inf would be
+          // NaN. A value beyond the float range is +Inf (the environment reader drops and counts
+          // such texels); black stays 0.
+          const double v = double(row[3 * x + k]) / exposure;
+          row[3 * x + k] = v > double(std::numeric_limits<float>::max()) ? std::numeric_limits<float>::infinity()
+                                                                         : float(v);
+        }
     }
   }
   return img;
