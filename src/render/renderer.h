@@ -77,8 +77,7 @@ class Renderer {
   void addStats(const RenderStats& carried) { m_integrator->addStats(carried); }
   RenderStats stats() const { return m_integrator->stats(); }
   // GPU time per stage name (camera, submit, intersect, "shade <model>" per shade pipeline, shadow,
-  // accumulate) summed over
-  // all passes so far; empty unless RenderSettings::timeStages.
+  // accumulate) summed over all passes so far; empty unless RenderSettings::timeStages.
   const std::vector<std::pair<std::string, double>>& stageSeconds() const { return m_integrator->stageSeconds(); }
   // Extension rays per bounce over all passes so far (Integrator::raysPerBounce).
   const std::vector<std::uint64_t>& raysPerBounce() const { return m_integrator->raysPerBounce(); }

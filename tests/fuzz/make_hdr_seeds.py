@@ -2,19 +2,14 @@
 """Writes the seeds of tests/fuzz/corpus/hdr (fuzz_hdr): small Radiance RGBE files that between
 them reach every branch of io/radiance_hdr.cpp's decoder: flat pixels, new-style run-length
 scanlines (runs and literals), an old-style run and an EXPOSURE line. Standard library only."""
-import math
 import os
+import sys
+
+# The RGBE encoding of the test maps (one definition in tools/).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools"))
+from make_env_maps import rgbe  # noqa: E402
 
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "corpus", "hdr")
-
-
-def rgbe(c):
-    m = max(c)
-    if m < 1e-32:
-        return bytes(4)
-    mant, e = math.frexp(m)
-    f = mant * 256.0 / m
-    return bytes([min(255, int(c[0] * f)), min(255, int(c[1] * f)), min(255, int(c[2] * f)), e + 128])
 
 
 def head(w, h, extra=b""):
