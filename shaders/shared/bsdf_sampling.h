@@ -99,30 +99,7 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
   pdf = 0.0f;
   continuation = 0.0f;
   if (wo.z <= 0.0f) return false;
-  if (model == MODEL_MIRROR) {
-    wi = brdfReflectZ(wo);
-    weight = mirrorReflectance(p, wo.z);
-    continuation = min(1.0f, luminance(weight));
-    return true;
-  }
-  if (model == MODEL_DIELECTRIC) {
-    // Reflect with probability R (Fresnel), refract otherwise: weight 1 for either, times the
-    // radiance scaling (n_wo / n_wi)^2 across the interface for refraction (catalogue 2.19).
-    float eta = brdfParam(p, DIELECTRIC_ETA);
-    float etaRel = inside ? 1.0f / eta : eta;  // n(wi side) / n(wo side) for transmission
-    float R = fresnelDielectric(wo.z, etaRel);
-    vec3 t;
-    if (u.x < R || !dielectricRefract(etaRel, wo, t)) {
-      wi = brdfReflectZ(wo);
-      weight = vec3(1.0f);
-    } else {
-      wi = t;
-      weight = vec3(1.0f / (etaRel * etaRel));
-    }
-    // The walk does not end at a lossless interface: the radiance scaling is not an albedo.
-    continuation = 1.0f;
-    return true;
-  }
+  if (modelIsDelta(model)) return deltaSample(model, p, wo, inside, u, wi, weight, continuation);
   uint s = effectiveSampler(strategy, quadSet);
 #if NUSSELT_WITH_QUADTREE
   if (s == SAMPLER_QUADTREE) {
@@ -165,16 +142,6 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
   // Without a tabulated albedo, the sample weight's luminance (its estimate) is the continuation.
   continuation = cont >= 0.0f ? cont : min(1.0f, luminance(weight));
   return true;
-}
-
-// The factor by which a refraction's radiance scaling (n_wo / n_wi)^2 is undone for the throughput
-// roulette (pbrt's and Mitsuba's etaScale): (n_wi / n_wo)^2 for a sample of `model` that crossed the
-// surface, 1 for everything else (only the dielectric transmits).
-SHARED_FN float transmissionEtaScale(uint model, BrdfParams p, bool inside) {
-  if (model != MODEL_DIELECTRIC) return 1.0f;
-  float eta = brdfParam(p, DIELECTRIC_ETA);
-  float etaRel = inside ? 1.0f / eta : eta;
-  return etaRel * etaRel;
 }
 
 // The throughput roulette (ROULETTE_THROUGHPUT): from bounce ROULETTE_MIN_BOUNCE on, the walk goes on
