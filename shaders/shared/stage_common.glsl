@@ -14,6 +14,7 @@
 #include "shared/warp.h"
 #include "shared/trace.glsl"
 #include "shared/envmap.h"
+#include "shared/texture.h"
 
 layout(local_size_x = WORKGROUP_SIZE) in;
 
@@ -21,6 +22,8 @@ layout(local_size_x = WORKGROUP_SIZE) in;
 // render builds only what its scene needs (lavapipe's Mesa 22.3 ran every branch body a subgroup
 // reached, taken or not; reference/lavapipe.md). Constant 7: after the shade stages' own 0..6.
 layout(constant_id = 7) const bool HAS_ENVIRONMENT = true;
+// Likewise the texture lookups of a scene without textures (Globals.texturedScene; constant 8).
+layout(constant_id = 8) const bool HAS_TEXTURES = true;
 
 // ---- Queues ---------------------------------------------------------------------------------
 
@@ -75,6 +78,20 @@ vec3 offsetRay(vec3 p, vec3 n) {
 vec3 triangleNormalUnnormalized(uint tri) {
   GpuTriangle t = g.triangles.v[tri];
   return cross(t.e1.xyz, t.e2.xyz);
+}
+
+// ---- Textures (shared/texture.h; docs/scenes.md, "Textures") ------------------------------------
+
+// The texel buffer as a plain reference (the globals block is readonly, and a member of it cannot
+// be passed to a function parameter without that qualifier).
+Uints texelBuffer() {
+  Uints t = g.texels;
+  return t;
+}
+
+// Texture `tex` (an index into g.textures) at barycentrics (b1, b2) of triangle tri.
+vec4 sceneTexture(uint tex, uint tri, float b1, float b2) {
+  return textureAtHit(texelBuffer(), g.textures.v[tex], g.texcoords.v[tri], b1, b2);
 }
 
 // ---- Lights ---------------------------------------------------------------------------------

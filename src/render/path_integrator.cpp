@@ -75,6 +75,8 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   g.pathCapacity = m_capacity;
   // The escape stage exists only for scenes with an environment (the device scene set it up).
   m_hasEscape = g.environmentLight != INVALID_INDEX;
+  // Texture code only in the shade stages of a scene with textures (the material table set it).
+  m_hasTextures = g.texturedScene != 0u;
 
   auto t0 = std::chrono::steady_clock::now();
   createPipelines();
@@ -157,6 +159,7 @@ void PathIntegrator::createPipelines() {
           // lacks are ignored by Vulkan.
           spec.resize(7, 0u);
           spec.push_back(m_hasEscape ? 1u : 0u);
+          spec.push_back(m_hasTextures ? 1u : 0u);  // constant 8: HAS_TEXTURES
           // One module per strategy (CMakeLists.txt): shade_sN / shade_combined_sN.
           const std::string module = std::string(key[0] > 0 ? "shade_combined" : "shade") + "_s" + std::to_string(sampler);
           m_shade[s] = vk::createComputePipeline(m_ctx, layout, module, spec);
