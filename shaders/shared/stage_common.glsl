@@ -94,6 +94,16 @@ vec4 sceneTexture(uint tex, uint tri, float b1, float b2) {
   return textureAtHit(texelBuffer(), g.textures.v[tex], g.texcoords.v[tri], b1, b2);
 }
 
+// The emitted radiance of `material` at barycentrics (b1, b2) of triangle tri: its emission times
+// its emissive texture when one applies. Light selection and its pdf use the emission factor only
+// (src/render/device_scene.cpp), so the texture enters as a value at the sampled or hit point and
+// both estimators (light sampling and BSDF sampling, with MIS) stay unbiased.
+vec3 texturedEmission(uint material, vec3 emission, uint tri, float b1, float b2) {
+  if (!HAS_TEXTURES || (g.materials.v[material].info.y & MATERIAL_TEXTURED) == 0u) return emission;
+  uint tex = g.materialTextures.v[material].maps.z;
+  return tex == INVALID_INDEX ? emission : emission * sceneTexture(tex, tri, b1, b2).xyz;
+}
+
 // ---- Lights ---------------------------------------------------------------------------------
 
 // Probability of selecting light i (the CDF is proportional to estimated power).
@@ -155,7 +165,9 @@ bool sampleLight(vec3 x, float uSelect, vec2 uPoint, out LightSample ls) {
     if (cosLight <= 0.0f) return false;
     ls.pdf = pSelect * dist2 / (0.5f * area2 * cosLight);
     uint material = g.shading.v[tri].info.x;
-    ls.value = g.materials.v[material].emission.xyz / ls.pdf;
+    vec3 Le = g.materials.v[material].emission.xyz;
+    if (HAS_TEXTURES) Le = texturedEmission(material, Le, tri, b.x, b.y);
+    ls.value = Le / ls.pdf;
     ls.dist = dist;
     return ls.pdf > 0.0f && isFinite(ls.pdf);
   }

@@ -36,6 +36,29 @@ float componentMisPdf(uint model, GpuComponent C, float c, vec3 wo, vec3 wi) {
 }
 #endif
 
+// ---- evalParams: the material's parameters at the hit (textures; docs/scenes.md, "Textures") ----
+// params: the model's parameters (the material's factors on entry); emission: its emitted
+// radiance. gltf_pbr: baseColor x baseColorTexture.rgb (sRGB decoded), metallic x B and roughness
+// x G of metallicRoughnessTexture; any model: emission x emissiveTexture.rgb (sRGB decoded).
+void evalParams(uint model, uint material, uint tri, float b1, float b2, inout BrdfParams params,
+                inout vec3 emission) {
+  GpuMaterialTextures T = g.materialTextures.v[material];
+  GpuTriTexcoords uv = g.texcoords.v[tri];
+  if (T.maps.z != INVALID_INDEX) emission *= textureAtHit(texelBuffer(), g.textures.v[T.maps.z], uv, b1, b2).xyz;
+  if (model == MODEL_GLTF_PBR) {
+    if (T.maps.x != INVALID_INDEX) {
+      vec4 c = textureAtHit(texelBuffer(), g.textures.v[T.maps.x], uv, b1, b2);
+      for (uint k = 0u; k < 3u; ++k)
+        params.v[(GLTF_PBR_BASE_COLOR + k) / 4u][(GLTF_PBR_BASE_COLOR + k) % 4u] *= c[k];
+    }
+    if (T.maps.y != INVALID_INDEX) {
+      vec4 mr = textureAtHit(texelBuffer(), g.textures.v[T.maps.y], uv, b1, b2);
+      params.v[GLTF_PBR_METALLIC / 4u][GLTF_PBR_METALLIC % 4u] *= mr.z;
+      params.v[GLTF_PBR_ROUGHNESS / 4u][GLTF_PBR_ROUGHNESS % 4u] *= mr.y;
+    }
+  }
+}
+
 void main() {
   uint idx = gl_GlobalInvocationID.x;
   uint queue = QUEUE_SHADE_BASE + pc.modelSlot;
@@ -63,6 +86,13 @@ void main() {
   vec3 ngFront = normalize(cross(T.e1.xyz, T.e2.xyz));
   vec3 ns = normalize((1.0f - hit.y - hit.z) * S.n0.xyz + hit.y * S.n1.xyz + hit.z * S.n2.xyz);
   GpuMaterial M = g.materials.v[S.info.x];
+  // evalParams: the parameters and emission at this point (differ from M's only where textured).
+  vec3 Le = M.emission.xyz;
+#if SHADE_COMBINED
+  if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) evalParams(INVALID_INDEX, S.info.x, tri, hit.y, hit.z, M.params, Le);
+#else
+  if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) evalParams(MODEL_ID, S.info.x, tri, hit.y, hit.z, M.params, Le);
+#endif
   vec4 throughput = g.pathThroughput.v[path];
   vec3 beta = throughput.xyz;
   float etaScale = throughput.w;
@@ -80,7 +110,7 @@ void main() {
         w = powerHeuristic(prevPdf, lightPdf);
       }
     }
-    L += beta * M.emission.xyz * w;
+    L += beta * Le * w;
   }
 
   // ---- Local frame: surfaces are two-sided, shade the side the ray came from ----

@@ -680,8 +680,8 @@ class Converter {
     if (!notRendered_.empty()) {
       std::string list;
       for (const std::string& f : notRendered_) list += (list.empty() ? "" : ", ") + f;
-      warnOnce("read but not rendered yet: " + list + " (materials render with their constant factors, opaque "
-               "and reflecting only)");
+      warnOnce("read but not rendered yet: " + list + " (rendered as if absent: opaque, reflecting only, "
+               "without those textures)");
     }
     if (flatUvTangents_ > 0)
       warnOnce(str(flatUvTangents_) + " triangle corner(s) of normal-mapped primitives have texture coordinates of "
@@ -1216,6 +1216,7 @@ class Converter {
     if (!std::isfinite(emission.x) || !std::isfinite(emission.y) || !std::isfinite(emission.z))
       fail(field + ": emissiveFactor x emissiveStrength overflows");
     m.emission = glm::vec3(emission);
+    warnUnrenderedTextures(m);
     return m;
   }
 
@@ -1243,8 +1244,6 @@ class Converter {
     m.emissiveTexture = textureRef(viewOf(gm.emissiveTexture), field + ".emissiveTexture", ColorSpace::Srgb);
     if (gm.occlusionTexture.index != -1)
       warnOnce("occlusionTexture is ignored: a path tracer computes occlusion itself (" + field + ")");
-    bool textured = m.baseColorTexture.present() || m.metallicRoughnessTexture.present() ||
-                    m.normalTexture.present() || m.emissiveTexture.present();
 
     if (gm.alphaMode == "OPAQUE" || gm.alphaMode.empty()) m.alphaMode = AlphaMode::Opaque;
     else if (gm.alphaMode == "MASK") m.alphaMode = AlphaMode::Mask;
@@ -1274,7 +1273,6 @@ class Converter {
       if (t->Has("transmissionTexture")) {
         m.transmissionTexture = textureRef(viewOf(t->Get("transmissionTexture"), f + ".transmissionTexture"),
                                            f + ".transmissionTexture", ColorSpace::Linear);
-        textured = textured || m.transmissionTexture.present();
       }
       notRenderedYet("KHR_materials_transmission");
     }
@@ -1307,7 +1305,16 @@ class Converter {
       }
       notRenderedYet("KHR_materials_volume");
     }
-    if (textured) notRenderedYet("textures");
+  }
+
+  // The textures the renderer does not apply yet (src/render/texture_table.h applies baseColor and
+  // metallicRoughness of gltf_pbr materials and every emissive texture).
+  void warnUnrenderedTextures(const Material& m) {
+    if (m.normalTexture.present()) notRenderedYet("normalTexture");
+    if (m.transmissionTexture.present()) notRenderedYet("transmissionTexture");
+    if ((m.combined() || m.model != MODEL_GLTF_PBR) &&
+        (m.baseColorTexture.present() || m.metallicRoughnessTexture.present()))
+      notRenderedYet("baseColorTexture/metallicRoughnessTexture of NUSSELT_brdf models other than gltf_pbr");
   }
 
   std::uint32_t defaultMaterial() {
