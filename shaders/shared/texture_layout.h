@@ -35,7 +35,8 @@ STATIC_ASSERT_SIZE(GpuTexture, 48);
 
 // The texture data of material i (parallel to the materials buffer, read only when the material
 // has MATERIAL_TEXTURED). maps = GpuTexture indices of (baseColor, metallicRoughness, emissive,
-// normal), INVALID_INDEX where the material has none or the renderer does not apply it;
+// normal), INVALID_INDEX where the material has none or the renderer does not apply it (a normal
+// map needs Globals.tangents);
 // baseColorFactor = rgba; factors = (metallicFactor, roughnessFactor, normalScale, alphaCutoff).
 struct GpuMaterialTextures {
   uvec4 maps;

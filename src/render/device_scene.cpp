@@ -71,6 +71,9 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene, TraversalStructur
   std::vector<shared::GpuTriTexcoords> texcoords(textured ? std::max<std::size_t>(triCount, 1) : 1);
   const bool has0 = scene.texcoords0.size() == scene.positions.size();
   const bool has1 = scene.texcoords1.size() == scene.positions.size();
+  // Tangents (3 vec4 per triangle) only for a scene with a normal map.
+  const bool normalMapped = sceneUsesNormalMaps(scene);
+  std::vector<glm::vec4> tangents(normalMapped ? 3 * std::max<std::size_t>(triCount, 1) : 1, glm::vec4(0.0f));
   std::vector<float> vertices;  // the bottom level's input: 3 vertices per triangle, in g.triangles order
   if (structures.accelerationStructures) vertices.reserve(9 * triCount);
   glm::vec3 lo(INFINITY), hi(-INFINITY);
@@ -99,6 +102,8 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene, TraversalStructur
       texcoords[k].b = glm::vec4(a[2], b[0]);
       texcoords[k].c = glm::vec4(b[1], b[2]);
     }
+    if (normalMapped)
+      for (int c = 0; c < 3; ++c) tangents[3 * k + c] = scene.tangents[3 * src + c];
     std::uint32_t mat = scene.triangleMaterial[src];
     std::uint32_t lightIndex = INVALID_INDEX;
     if (scene.materials[mat].emits()) {
@@ -196,6 +201,7 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene, TraversalStructur
   make(m_lightBuffer, lights.size() * sizeof(GpuLight), "light", lights.data());
   make(m_lightCdf, cdf.size() * sizeof(float), "light CDF", cdf.data());
   make(m_texcoords, texcoords.size() * sizeof(shared::GpuTriTexcoords), "triangle texture coordinates", texcoords.data());
+  make(m_tangents, tangents.size() * sizeof(glm::vec4), "triangle tangents", tangents.data());
 
   if (env.emits()) {
     make(m_envTexels, env.texels.size() * sizeof(glm::vec4), "environment texels", env.texels.data());
@@ -234,13 +240,13 @@ void DeviceScene::release() {
   vk::destroyAccelerationStructure(m_ctx, m_tlas);
   vk::destroyAccelerationStructure(m_ctx, m_blas);
   for (vk::Buffer* b : {&m_bvh, &m_tris, &m_shading, &m_lightBuffer, &m_lightCdf, &m_envTexels, &m_envDistribution,
-                        &m_envStruct, &m_texcoords})
+                        &m_envStruct, &m_texcoords, &m_tangents})
     vk::destroyBuffer(m_ctx, *b);
 }
 
 std::uint64_t DeviceScene::deviceBytes() const {
   return m_bvh.size + m_tris.size + m_shading.size + m_lightBuffer.size + m_lightCdf.size + m_envTexels.size +
-         m_envDistribution.size + m_envStruct.size + m_texcoords.size + accelerationBytes();
+         m_envDistribution.size + m_envStruct.size + m_texcoords.size + m_tangents.size + accelerationBytes();
 }
 
 void DeviceScene::fillGlobals(shared::Globals& g) const {
@@ -256,6 +262,7 @@ void DeviceScene::fillGlobals(shared::Globals& g) const {
   g.environment = m_envStruct.buffer ? m_envStruct.address : 0;
   g.triangleCount = static_cast<std::uint32_t>(m_triangles);
   g.texcoords = m_texcoords.address;
+  g.tangents = m_tangents.address;
   g.tlasLow = static_cast<std::uint32_t>(m_tlas.address);
   g.tlasHigh = static_cast<std::uint32_t>(m_tlas.address >> 32);
 }

@@ -96,7 +96,7 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
       const Material& m = scene.materials[i];
       // A texture that varies the BRDF's parameters over the surface: no one table fits, the
       // strategy falls back to cosine (INVALID_INDEX; docs/scenes.md, "Textures").
-      if (!m.combined() && !modelById(m.model).delta && !textureUse(m).paramsVary()) {
+      if (!m.combined() && !modelById(m.model).delta && !textureUse(m, scene).paramsVary()) {
         toBuild.push_back({m.model, m.params});
         uses.push_back({static_cast<std::uint32_t>(i), -1});
       }
@@ -166,7 +166,7 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     for (const MaterialComponent& c : src.components) allDelta = allDelta && modelById(c.model).delta;
     if (src.combined() ? allDelta : modelById(src.model).delta) flags |= MATERIAL_DELTA;
     if (src.combined()) flags |= MATERIAL_COMBINED;
-    if (used[i] && textureUse(src).any()) flags |= MATERIAL_TEXTURED;
+    if (used[i] && textureUse(src, scene).any()) flags |= MATERIAL_TEXTURED;
     const std::uint32_t material = static_cast<std::uint32_t>(i);
     dst.info = glm::uvec4(src.combined() ? src.components[0].model : src.model, flags,
                           src.combined() ? INVALID_INDEX : setFor(material, -1), slot);

@@ -10,22 +10,34 @@ namespace nusselt {
 using shared::GpuMaterialTextures;
 using shared::GpuTexture;
 
-MaterialTextureUse textureUse(const Material& m) {
+MaterialTextureUse textureUse(const Material& m, const Scene& scene) {
   MaterialTextureUse u;
   const bool pbr = !m.combined() && m.model == MODEL_GLTF_PBR;
   u.baseColor = pbr && m.baseColorTexture.present();
   u.metallicRoughness = pbr && m.metallicRoughnessTexture.present();
   u.emissive = m.emits() && m.emissiveTexture.present();
+  u.normal = m.normalTexture.present() && !scene.tangents.empty() && scene.tangents.size() == scene.positions.size();
   return u;
 }
 
-bool sceneUsesTextures(const Scene& scene) {
+namespace {
+template <class F>
+bool anyUsedMaterial(const Scene& scene, F f) {
   std::vector<bool> used(scene.materials.size(), false);
   for (std::uint32_t m : scene.triangleMaterial)
     if (m < used.size()) used[m] = true;
   for (std::size_t i = 0; i < scene.materials.size(); ++i)
-    if (used[i] && textureUse(scene.materials[i]).any()) return true;
+    if (used[i] && f(textureUse(scene.materials[i], scene))) return true;
   return false;
+}
+}  // namespace
+
+bool sceneUsesTextures(const Scene& scene) {
+  return anyUsedMaterial(scene, [](const MaterialTextureUse& u) { return u.any(); });
+}
+
+bool sceneUsesNormalMaps(const Scene& scene) {
+  return anyUsedMaterial(scene, [](const MaterialTextureUse& u) { return u.normal; });
 }
 
 std::vector<std::uint32_t> packTexels(const TextureImage& image) {
@@ -83,10 +95,11 @@ TextureData buildTextureData(const Scene& scene) {
     g.factors = glm::vec4(m.metallicFactor, m.roughnessFactor, m.normalScale, m.alphaCutoff);
     g.reserved = glm::uvec4(0u);
     if (!used[i]) continue;
-    const MaterialTextureUse u = textureUse(m);
+    const MaterialTextureUse u = textureUse(m, scene);
     if (u.baseColor) g.maps.x = add(m.baseColorTexture, m.name + " baseColorTexture");
     if (u.metallicRoughness) g.maps.y = add(m.metallicRoughnessTexture, m.name + " metallicRoughnessTexture");
     if (u.emissive) g.maps.z = add(m.emissiveTexture, m.name + " emissiveTexture");
+    if (u.normal) g.maps.w = add(m.normalTexture, m.name + " normalTexture");
   }
   return d;
 }

@@ -16,15 +16,18 @@ struct MaterialTextureUse {
   bool baseColor = false;          // gltf_pbr materials (single-model): baseColor x baseColorFactor
   bool metallicRoughness = false;  // gltf_pbr: G x roughnessFactor, B x metallicFactor
   bool emissive = false;           // any material with a non-zero emission: RGB x emission
-  bool any() const { return baseColor || metallicRoughness || emissive; }
+  bool normal = false;             // any material: the shading normal (needs Scene::tangents)
+  bool any() const { return baseColor || metallicRoughness || emissive || normal; }
   // The BRDF's parameters (not only its emission) vary over the surface: no per-material
   // sampling tables fit it (the quadtree and tabulated samplers fall back to cosine).
   bool paramsVary() const { return baseColor || metallicRoughness; }
 };
-MaterialTextureUse textureUse(const Material& m);
+// scene: for the normal map, which needs the scene's tangents (Scene::tangents per corner).
+MaterialTextureUse textureUse(const Material& m, const Scene& scene);
 
-// Some material that a triangle uses has a texture the renderer applies.
+// Some material that a triangle uses has a texture the renderer applies (normal: a normal map).
 bool sceneUsesTextures(const Scene& scene);
+bool sceneUsesNormalMaps(const Scene& scene);
 
 // The packed textures. Empty vectors when the scene uses none.
 struct TextureData {

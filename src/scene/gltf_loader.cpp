@@ -1308,9 +1308,8 @@ class Converter {
   }
 
   // The textures the renderer does not apply yet (src/render/texture_table.h applies baseColor and
-  // metallicRoughness of gltf_pbr materials and every emissive texture).
+  // metallicRoughness of gltf_pbr materials and every emissive and normal texture).
   void warnUnrenderedTextures(const Material& m) {
-    if (m.normalTexture.present()) notRenderedYet("normalTexture");
     if (m.transmissionTexture.present()) notRenderedYet("transmissionTexture");
     if ((m.combined() || m.model != MODEL_GLTF_PBR) &&
         (m.baseColorTexture.present() || m.metallicRoughnessTexture.present()))

@@ -273,3 +273,72 @@ TEST(TexturesRender, BaseColorAndMetallicRoughnessTexturesGiveThePredictedAlbedo
   EXPECT_GT(minSeparation, 20.0) << "the cells' predicted albedos are too close to tell textures apart";
   EXPECT_EQ(test::validationMessages(), 0u);
 }
+
+// Normal maps: two flat quads (Lambert, rho 0.5) side by side, each with a constant 1 x 1 normal
+// map, under a directional light of irradiance E: every pixel is rho / pi x E x max(0, n.l) for
+// the normal n its texel encodes in the frame of scene.h (n = x t + y b + z N, b = w cross(N, t)),
+// i.e. the flat quad shades as the tilted plane. Left: tilted 30 degrees towards the tangent
+// (+x), w = +1. Right: tilted towards the bitangent with w = -1 (b = -y) and normalScale 0.5.
+// Direct light only (max depth 1): no noise, checked to 1e-4 relative.
+TEST(TexturesRender, ConstantNormalMapShadesAsTheTiltedPlane) {
+  Scene s;
+  const float a = 0.5235988f;  // 30 degrees
+  const glm::vec3 ts[2] = {{std::sin(a), 0.0f, std::cos(a)}, {0.0f, std::sin(a), std::cos(a)}};
+  const float scale[2] = {1.0f, 0.5f};
+  const float w[2] = {1.0f, -1.0f};
+  glm::vec3 expectedNormal[2];
+  for (int q = 0; q < 2; ++q) {
+    glm::ivec3 code;
+    for (int k = 0; k < 3; ++k) code[k] = int(std::lround((ts[q][k] + 1.0f) * 0.5f * 255.0f));
+    int image = addImage(s, 1, 1, [&](int, int) { return glm::ivec4(code, 255); });
+    Material m;
+    m.name = q == 0 ? "tangent" : "bitangent";
+    m.model = findModel("lambert")->id;
+    m.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(0.5)}}, m.name);
+    m.normalTexture = nearest(image, ColorSpace::Linear);
+    m.normalScale = scale[q];
+    s.materials.push_back(m);
+    const float x0 = q == 0 ? -1.0f : 0.0f;
+    glm::vec3 A(x0, -1, 0), B(x0 + 1, -1, 0), C(x0 + 1, 1, 0), D(x0, 1, 0);
+    test::addQuad(s, A, B, C, D, std::uint32_t(q));
+    for (glm::vec3 p : {A, B, C, A, C, D}) {
+      s.texcoords0.push_back(glm::vec2(p.x - x0, (1 - p.y) / 2));
+      s.tangents.push_back(glm::vec4(1, 0, 0, w[q]));
+    }
+    // The shader's arithmetic on the decoded texel: [0, 1] -> [-1, 1], xy x scale, in the frame.
+    glm::vec3 c = glm::vec3(code) / 255.0f * 2.0f - 1.0f;
+    glm::vec3 t(1, 0, 0), N(0, 0, 1), b = w[q] * glm::cross(N, t);
+    expectedNormal[q] = glm::normalize(c.x * scale[q] * t + c.y * scale[q] * b + c.z * N);
+  }
+  const glm::vec3 l = glm::normalize(glm::vec3(0.5f, -0.6f, 1.0f));  // towards the light
+  PunctualLight sun;
+  sun.type = LightType::Directional;
+  sun.direction = -l;
+  sun.intensity = glm::vec3(2.0f);
+  s.lights.push_back(sun);
+  lookDown(s, 1.0f, 1.0f);
+  RenderSettings rs;
+  rs.width = rs.height = 16;
+  rs.spp = 4;
+  rs.maxDepth = 1;
+  rs.seed = 3;
+  test::Rendered r = test::render(s, rs);
+  int bad = 0;
+  double value[2];
+  for (int q = 0; q < 2; ++q) value[q] = 0.5 / M_PI * 2.0 * std::max(0.0f, glm::dot(expectedNormal[q], l));
+  const double flat = 0.5 / M_PI * 2.0 * l.z;
+  EXPECT_GT(std::fabs(value[0] - flat), 0.05 * flat);  // the maps change the image
+  EXPECT_GT(std::fabs(value[1] - flat), 0.05 * flat);
+  for (int py = 0; py < 16; ++py)
+    for (int px = 0; px < 16; ++px) {
+      double expected = value[px < 8 ? 0 : 1];
+      for (int k = 0; k < 3; ++k) {
+        double got = r.image.rgb[3 * (py * 16 + px) + k];
+        if (!(std::fabs(got - expected) <= 1e-4 * expected) && ++bad <= 5)
+          ADD_FAILURE() << "pixel (" << px << ", " << py << ") channel " << k << ": " << got << ", expected " << expected
+                        << " (flat " << flat << ")";
+      }
+    }
+  EXPECT_EQ(bad, 0);
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
