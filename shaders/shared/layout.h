@@ -75,6 +75,7 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 #define MATERIAL_DELTA 2u     // every component of the material is a delta model (no light samples)
 #define MATERIAL_COMBINED 4u  // a weighted sum of elementary BRDFs (GpuMaterial.components)
 #define MATERIAL_TEXTURED 8u  // a texture applies (Globals.materialTextures: GpuMaterialTextures)
+#define MATERIAL_ALPHA 16u    // alphaMode MASK or BLEND: hits are tested in traversal (trace.glsl)
 
 // ---- Combined materials ---------------------------------------------------------------------------
 // At most this many components per material: the shade stage is specialised per tuple of component
@@ -259,7 +260,7 @@ struct Globals {
   // (the uints above fill their 16-byte rows; a new row of four)
   uint environmentLight; // the environment's index in the light list, or INVALID_INDEX: no environment
   uint texturedScene;    // 1: some material has a texture that applies (the HAS_TEXTURES stages), else 0
-  uint reserved2;
+  uint alphaScene;       // 1: some material has alphaMode MASK or BLEND (the HAS_ALPHA tracing stages), else 0
   uint reserved3;
   vec4 camPosition; // xyz, w = 1 for orthographic
   vec4 camRight;    // unit right * (tan(yfov/2) * aspect), or * xmag for orthographic

@@ -37,14 +37,21 @@ STATIC_ASSERT_SIZE(GpuTexture, 48);
 // has MATERIAL_TEXTURED). maps = GpuTexture indices of (baseColor, metallicRoughness, emissive,
 // normal), INVALID_INDEX where the material has none or the renderer does not apply it (a normal
 // map needs Globals.tangents);
-// baseColorFactor = rgba; factors = (metallicFactor, roughnessFactor, normalScale, alphaCutoff).
+// baseColorFactor = rgba; factors = (metallicFactor, roughnessFactor, normalScale, alphaCutoff);
+// alpha = (ALPHA_* mode, the GpuTexture whose alpha multiplies baseColorFactor.a (the base-colour
+// texture, for any model) or INVALID_INDEX, 0, 0).
 struct GpuMaterialTextures {
   uvec4 maps;
   vec4 baseColorFactor;
   vec4 factors;
-  uvec4 reserved;
+  uvec4 alpha;
 };
 STATIC_ASSERT_SIZE(GpuMaterialTextures, 64);
+
+// glTF alphaMode (the values of scene.h's AlphaMode).
+#define ALPHA_OPAQUE 0u
+#define ALPHA_MASK 1u
+#define ALPHA_BLEND 2u
 
 // Texture coordinates of a triangle's corners, both sets (parallel to the triangles buffer):
 // a = (set 0 corner 0, set 0 corner 1), b = (set 0 corner 2, set 1 corner 0),

@@ -167,6 +167,7 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     if (src.combined() ? allDelta : modelById(src.model).delta) flags |= MATERIAL_DELTA;
     if (src.combined()) flags |= MATERIAL_COMBINED;
     if (used[i] && textureUse(src, scene).any()) flags |= MATERIAL_TEXTURED;
+    if (used[i] && textureUse(src, scene).alpha) flags |= MATERIAL_ALPHA;
     const std::uint32_t material = static_cast<std::uint32_t>(i);
     dst.info = glm::uvec4(src.combined() ? src.components[0].model : src.model, flags,
                           src.combined() ? INVALID_INDEX : setFor(material, -1), slot);
@@ -210,7 +211,8 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
   make(m_tabData, tab.data.size(), sizeof(float), "tabulated cdfs", tab.data.data());
   // Textures: one-entry buffers when the scene has none.
   const TextureData textures = buildTextureData(scene);
-  m_textured = !textures.textures.empty();
+  m_textured = !textures.materials.empty();
+  m_alpha = sceneUsesAlpha(scene);
   make(m_textures, textures.textures.size(), sizeof(shared::GpuTexture), "textures", textures.textures.data());
   make(m_texels, textures.texels.size(), sizeof(std::uint32_t), "texels", textures.texels.data());
   make(m_materialTextures, textures.materials.size(), sizeof(shared::GpuMaterialTextures), "material textures",
@@ -254,6 +256,7 @@ void MaterialTable::fillGlobals(shared::Globals& g) const {
   g.texels = m_texels.address;
   g.materialTextures = m_materialTextures.address;
   g.texturedScene = m_textured ? 1u : 0u;
+  g.alphaScene = m_alpha ? 1u : 0u;
   g.materialCount = static_cast<std::uint32_t>(std::max<std::size_t>(m_materialCount, 1));
 }
 

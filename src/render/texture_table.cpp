@@ -16,6 +16,7 @@ MaterialTextureUse textureUse(const Material& m, const Scene& scene) {
   u.baseColor = pbr && m.baseColorTexture.present();
   u.metallicRoughness = pbr && m.metallicRoughnessTexture.present();
   u.emissive = m.emits() && m.emissiveTexture.present();
+  u.alpha = m.alphaMode != AlphaMode::Opaque;
   u.normal = m.normalTexture.present() && !scene.tangents.empty() && scene.tangents.size() == scene.positions.size();
   return u;
 }
@@ -34,6 +35,10 @@ bool anyUsedMaterial(const Scene& scene, F f) {
 
 bool sceneUsesTextures(const Scene& scene) {
   return anyUsedMaterial(scene, [](const MaterialTextureUse& u) { return u.any(); });
+}
+
+bool sceneUsesAlpha(const Scene& scene) {
+  return anyUsedMaterial(scene, [](const MaterialTextureUse& u) { return u.alpha; });
 }
 
 bool sceneUsesNormalMaps(const Scene& scene) {
@@ -93,13 +98,16 @@ TextureData buildTextureData(const Scene& scene) {
     g.maps = glm::uvec4(INVALID_INDEX);
     g.baseColorFactor = m.baseColorFactor;
     g.factors = glm::vec4(m.metallicFactor, m.roughnessFactor, m.normalScale, m.alphaCutoff);
-    g.reserved = glm::uvec4(0u);
+    g.alpha = glm::uvec4(static_cast<std::uint32_t>(m.alphaMode), INVALID_INDEX, 0u, 0u);
     if (!used[i]) continue;
     const MaterialTextureUse u = textureUse(m, scene);
     if (u.baseColor) g.maps.x = add(m.baseColorTexture, m.name + " baseColorTexture");
     if (u.metallicRoughness) g.maps.y = add(m.metallicRoughnessTexture, m.name + " metallicRoughnessTexture");
     if (u.emissive) g.maps.z = add(m.emissiveTexture, m.name + " emissiveTexture");
     if (u.normal) g.maps.w = add(m.normalTexture, m.name + " normalTexture");
+    // Coverage: the base-colour texture's alpha, for any model (its RGB applies to gltf_pbr only).
+    if (u.alpha && m.baseColorTexture.present())
+      g.alpha.y = u.baseColor ? g.maps.x : add(m.baseColorTexture, m.name + " baseColorTexture (alpha)");
   }
   return d;
 }

@@ -17,7 +17,8 @@ struct MaterialTextureUse {
   bool metallicRoughness = false;  // gltf_pbr: G x roughnessFactor, B x metallicFactor
   bool emissive = false;           // any material with a non-zero emission: RGB x emission
   bool normal = false;             // any material: the shading normal (needs Scene::tangents)
-  bool any() const { return baseColor || metallicRoughness || emissive || normal; }
+  bool alpha = false;              // any material: alphaMode MASK or BLEND (coverage in traversal)
+  bool any() const { return baseColor || metallicRoughness || emissive || normal || alpha; }
   // The BRDF's parameters (not only its emission) vary over the surface: no per-material
   // sampling tables fit it (the quadtree and tabulated samplers fall back to cosine).
   bool paramsVary() const { return baseColor || metallicRoughness; }
@@ -28,6 +29,7 @@ MaterialTextureUse textureUse(const Material& m, const Scene& scene);
 // Some material that a triangle uses has a texture the renderer applies (normal: a normal map).
 bool sceneUsesTextures(const Scene& scene);
 bool sceneUsesNormalMaps(const Scene& scene);
+bool sceneUsesAlpha(const Scene& scene);
 
 // The packed textures. Empty vectors when the scene uses none.
 struct TextureData {

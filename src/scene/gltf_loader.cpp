@@ -1253,7 +1253,6 @@ class Converter {
       fail(field + ".alphaCutoff: " + fmt(gm.alphaCutoff) + " is not a finite number >= 0");
     m.alphaCutoff = float(std::min(gm.alphaCutoff, 2.0));  // above 1 all alike: nothing passes
     m.doubleSided = gm.doubleSided;
-    if (m.alphaMode != AlphaMode::Opaque) notRenderedYet("alphaMode MASK/BLEND");
 
     auto extension = [&](const char* name) -> const tinygltf::Value* {
       auto it = gm.extensions.find(name);

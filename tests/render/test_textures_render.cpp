@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "../support/test_support.h"
 #include "brdf/registry.h"
@@ -340,5 +341,115 @@ TEST(TexturesRender, ConstantNormalMapShadesAsTheTiltedPlane) {
       }
     }
   EXPECT_EQ(bad, 0);
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+namespace {
+
+Material lambert(const std::string& name, double rho) {
+  Material m;
+  m.name = name;
+  m.model = findModel("lambert")->id;
+  m.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(rho)}}, name);
+  return m;
+}
+
+// The traversals this device has: the GLSL BVH, and ray queries when offered.
+std::vector<Traversal> traversals() {
+  std::vector<Traversal> t{Traversal::Bvh};
+  if (test::context().rayQuery) t.push_back(Traversal::RayQuery);
+  return t;
+}
+
+}  // namespace
+
+// alphaMode MASK: a black quad whose base-colour texture's alpha is (1, 0 / 0.39, 0.78) per
+// texel, cutoff 0.5, in front of an emitter of radiance 1, seen straight down with max depth 0:
+// each 8 x 8 pixel cell is exactly 0 where alpha >= cutoff (the quad) and 1 where it is cut out
+// (the emitter behind), under both traversals. The texture's RGB does not apply (lambert).
+TEST(TexturesRender, MaskCutsOutWhereAlphaIsBelowTheCutoff) {
+  Scene s;
+  Material lamp = lambert("lamp", 0.0);
+  lamp.emission = glm::vec3(1.0f);
+  s.materials.push_back(lamp);
+  Material mask = lambert("mask", 0.0);
+  mask.alphaMode = AlphaMode::Mask;
+  mask.alphaCutoff = 0.5f;
+  const int alphaCode[4] = {255, 0, 100, 200};
+  mask.baseColorTexture = nearest(addImage(s, 2, 2, [&](int x, int y) {
+    return glm::ivec4(255, 0, 0, alphaCode[x + 2 * y]);
+  }), ColorSpace::Srgb);
+  s.materials.push_back(mask);
+  addTexturedQuad(s, 0.0f, 0);
+  addTexturedQuad(s, 0.5f, 1);
+  lookDown(s, 1.0f, 1.0f);
+  for (Traversal tr : traversals()) {
+    RenderSettings rs;
+    rs.width = rs.height = 16;
+    rs.spp = 4;
+    rs.maxDepth = 0;
+    rs.seed = 9;
+    rs.traversal = tr;
+    test::Rendered r = test::render(s, rs);
+    int bad = 0;
+    for (int py = 0; py < 16; ++py)
+      for (int px = 0; px < 16; ++px) {
+        const bool opaque = alphaCode[px / 8 + 2 * (py / 8)] / 255.0f >= 0.5f;
+        const float expected = opaque ? 0.0f : 1.0f;
+        for (int k = 0; k < 3; ++k)
+          if (std::fabs(r.image.rgb[3 * (py * 16 + px) + k] - expected) > 1e-6f && ++bad <= 5)
+            ADD_FAILURE() << (tr == Traversal::Bvh ? "bvh" : "rayquery") << " pixel (" << px << ", " << py
+                          << "): " << r.image.rgb[3 * (py * 16 + px) + k] << ", expected " << expected;
+      }
+    EXPECT_EQ(bad, 0);
+  }
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// alphaMode BLEND, stochastic: a black quad of alpha 0.5 (baseColorFactor) between an
+// orthographic camera and a Lambert floor (rho 0.8) lit by a directional light. A camera ray
+// passes the quad with probability 1/2, and so does the floor's shadow ray: the image converges
+// to 1/4 of the unoccluded floor, rho / pi E cos. z-test of the image mean per channel with the
+// per-pixel variances, significance 0.001 with Sidak over 3 channels x 2 traversals.
+TEST(TexturesRender, HalfTransparentBlendPassesHalfOfCameraAndShadowRays) {
+  Scene s;
+  s.materials.push_back(lambert("floor", 0.8));
+  Material veil = lambert("veil", 0.0);
+  veil.alphaMode = AlphaMode::Blend;
+  veil.baseColorFactor = glm::vec4(1.0f, 1.0f, 1.0f, 0.5f);
+  s.materials.push_back(veil);
+  addTexturedQuad(s, 0.0f, 0);
+  addTexturedQuad(s, 0.5f, 1);
+  const glm::vec3 l = glm::normalize(glm::vec3(0.3f, 0.2f, 1.0f));
+  PunctualLight sun;
+  sun.type = LightType::Directional;
+  sun.direction = -l;
+  sun.intensity = glm::vec3(2.0f);
+  s.lights.push_back(sun);
+  lookDown(s, 1.0f, 0.9f);
+  const double open = 0.8 / M_PI * 2.0 * l.z;
+  const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 6.0)));
+  for (Traversal tr : traversals()) {
+    RenderSettings rs;
+    rs.width = rs.height = 16;
+    rs.spp = 64;
+    rs.maxDepth = 1;
+    rs.seed = 13;
+    rs.traversal = tr;
+    test::Rendered r = test::render(s, rs);
+    for (int k = 0; k < 3; ++k) {
+      double sum = 0, var = 0;
+      for (int p = 0; p < 256; ++p) {
+        sum += r.image.rgb[3 * p + k];
+        var += r.image.variance[3 * p + k];
+      }
+      double mean = sum / 256, se = std::sqrt(var) / 256;
+      EXPECT_LT(std::fabs(mean - 0.25 * open) / se, zMax)
+          << (tr == Traversal::Bvh ? "bvh" : "rayquery") << " channel " << k << ": mean " << mean << ", expected "
+          << 0.25 * open << " (se " << se << ")";
+      // Neither opaque (0) nor absent (open) nor transparent to one kind of ray only (open / 2).
+      EXPECT_GT(std::fabs(mean - 0.5 * open) / se, 10.0);
+    }
+  }
   EXPECT_EQ(test::validationMessages(), 0u);
 }
