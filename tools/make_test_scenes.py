@@ -21,6 +21,11 @@
                  along x, metallic along z), a back wall with a baseColor texture on TEXCOORD_1
                  (LINEAR, MIRRORED_REPEAT) and a lamp with an emissive stripe texture (sRGB).
                  The PNGs are generated here (zlib) and embedded as data URIs.
+  glass_slab.gltf  a slab of glass (KHR_materials_transmission 1, KHR_materials_ior 1.5, metallic 0)
+                 between z = 0.2 and 0.4 (its top and bottom faces, outward normals) over an
+                 emitter of radiance 1 at z = 0 facing +z; camera above, looking down. Seen
+                 through the slab at normal incidence the emitter converges to (1 - R) / (1 + R)
+                 with R = 0.04 (both faces and every internal reflection).
 
 Emissive surfaces are one-sided: they emit on the side of their geometric normal
 (v1 - v0) x (v2 - v0), so every triangle here is wound to face where it should emit or be seen.
@@ -406,6 +411,21 @@ def textures():
     b.write("textures.gltf")
 
 
+def glass_slab():
+    b = Builder()
+    b.use("KHR_materials_transmission")
+    b.use("KHR_materials_ior")
+    glass = b.pbr_material("glass", {"metallicFactor": 0.0, "roughnessFactor": 0.0},
+                           extensions={"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                                       "KHR_materials_ior": {"ior": 1.5}})
+    lamp = b.material("lamp", 0.0, emission=(1.0, 1.0, 1.0))
+    b.quad("lamp", [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], lamp)
+    b.quad("top", [[-1, -1, 0.4], [1, -1, 0.4], [1, 1, 0.4], [-1, 1, 0.4]], glass)
+    b.quad("bottom", [[-1, -1, 0.2], [-1, 1, 0.2], [1, 1, 0.2], [1, -1, 0.2]], glass)
+    b.camera("camera", (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), 0.3, 1.0)
+    b.write("glass_slab.gltf")
+
+
 if __name__ == "__main__":
     furnace()
     mis()
@@ -415,3 +435,4 @@ if __name__ == "__main__":
     env_bench(False)
     env_bench(True)
     textures()
+    glass_slab()

@@ -1194,6 +1194,7 @@ class Converter {
                              {"metallic", factor(pbr.metallicFactor, "metallicFactor")},
                              {"roughness", factor(pbr.roughnessFactor, "roughnessFactor")}},
                             name_ + ": " + field);
+      transmissiveMaterial(m, name_ + ": " + field);
     }
 
     const std::vector<double>& e = gm.emissiveFactor;
@@ -1273,14 +1274,18 @@ class Converter {
         m.transmissionTexture = textureRef(viewOf(t->Get("transmissionTexture"), f + ".transmissionTexture"),
                                            f + ".transmissionTexture", ColorSpace::Linear);
       }
-      notRenderedYet("KHR_materials_transmission");
+      // Rendered (convertMaterial, transmissiveMaterial) unless NUSSELT_brdf sets the BRDF.
+      if (gm.extensions.count("NUSSELT_brdf")) notRenderedYet("KHR_materials_transmission with NUSSELT_brdf");
     }
     if (const tinygltf::Value* t = extension("KHR_materials_ior")) {
       const std::string f = field + " KHR_materials_ior";
       double ior = number(*t, "ior", f, 1.5);
       if (!std::isfinite(ior) || ior < 1 || ior > 100) fail(f + ".ior: " + fmt(ior) + " is not in [1, 100]");
       m.ior = float(ior);
-      notRenderedYet("KHR_materials_ior");
+      // Rendered as the dielectric's index of a transmitting material; not in the reflection
+      // (gltf_pbr's f0 stays 0.04).
+      if (!(m.transmissionFactor > 0) || gm.extensions.count("NUSSELT_brdf"))
+        notRenderedYet("KHR_materials_ior (used only with KHR_materials_transmission)");
     }
     if (const tinygltf::Value* t = extension("KHR_materials_volume")) {
       const std::string f = field + " KHR_materials_volume";
@@ -1306,13 +1311,41 @@ class Converter {
     }
   }
 
+  // KHR_materials_transmission as smooth transmission (docs/scenes.md, "Transmission"): a combined
+  // material, gltf_pbr with weight 1 - w and the smooth dielectric of index ior (clamped to the
+  // model's [0.1, 10]) with weight w = transmissionFactor x (1 - metallic): the dielectric's
+  // Fresnel reflection and the gltf_pbr component's reflection together reflect as gltf_pbr
+  // alone, and the gltf_pbr diffuse lobe is scaled by 1 - w, as the extension's mix of diffuse and
+  // transmission does. w = 1: the dielectric alone.
+  void transmissiveMaterial(Material& m, const std::string& context) {
+    const float w = m.transmissionFactor * (1.0f - m.metallicFactor);
+    if (!(w > 0.0f)) return;
+    BrdfParams glass = packParams(*findModel("dielectric"), {{"eta", ParamValue::num(std::min(m.ior, 10.0f))}},
+                                  context + " (transmission)");
+    if (w >= 1.0f) {
+      m.model = MODEL_DIELECTRIC;
+      m.params = glass;
+      return;
+    }
+    MaterialComponent base;
+    base.model = MODEL_GLTF_PBR;
+    base.weight = 1.0f - w;
+    base.params = m.params;
+    MaterialComponent clear;
+    clear.model = MODEL_DIELECTRIC;
+    clear.weight = w;
+    clear.params = glass;
+    m.components = {base, clear};
+  }
+
   // The textures the renderer does not apply yet (src/render/texture_table.h applies baseColor and
   // metallicRoughness of gltf_pbr materials and every emissive and normal texture).
   void warnUnrenderedTextures(const Material& m) {
     if (m.transmissionTexture.present()) notRenderedYet("transmissionTexture");
     if ((m.combined() || m.model != MODEL_GLTF_PBR) &&
         (m.baseColorTexture.present() || m.metallicRoughnessTexture.present()))
-      notRenderedYet("baseColorTexture/metallicRoughnessTexture of NUSSELT_brdf models other than gltf_pbr");
+      notRenderedYet("baseColorTexture/metallicRoughnessTexture RGB of materials other than a single gltf_pbr "
+                     "(NUSSELT_brdf models, combined or transmissive materials)");
   }
 
   std::uint32_t defaultMaterial() {
