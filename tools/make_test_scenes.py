@@ -15,6 +15,17 @@
   combined.gltf  combined materials (NUSSELT_brdf components) in a small coloured box under an
                  area light: lambert + phong + mirror, lambert + dielectric, a saturated lambert
                  + a white phong; for renders that exercise every combined-material code path.
+  textures.gltf  glTF textures as the renderer applies them (docs/scenes.md, "Textures"): a
+                 gltf_pbr floor with a baseColor checker (NEAREST, REPEAT, KHR_texture_transform
+                 scale 3) and a metallicRoughness gradient (LINEAR, CLAMP_TO_EDGE: roughness
+                 along x, metallic along z), a back wall with a baseColor texture on TEXCOORD_1
+                 (LINEAR, MIRRORED_REPEAT) and a lamp with an emissive stripe texture (sRGB).
+                 The PNGs are generated here (zlib) and embedded as data URIs.
+  glass_slab.gltf  a slab of glass (KHR_materials_transmission 1, KHR_materials_ior 1.5, metallic 0)
+                 between z = 0.2 and 0.4 (its top and bottom faces, outward normals) over an
+                 emitter of radiance 1 at z = 0 facing +z; camera above, looking down. Seen
+                 through the slab at normal incidence the emitter converges to (1 - R) / (1 + R)
+                 with R = 0.04 (both faces and every internal reflection).
 
 Emissive surfaces are one-sided: they emit on the side of their geometric normal
 (v1 - v0) x (v2 - v0), so every triangle here is wound to face where it should emit or be seen.
@@ -25,6 +36,7 @@ import json
 import math
 import os
 import struct
+import zlib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 OUT = os.path.join(ROOT, "scenes", "tests")
@@ -68,6 +80,16 @@ def look_at_quaternion(eye, target, up=(0.0, 1.0, 0.0)):
         s = math.sqrt(1.0 + m[2][2] - m[0][0] - m[1][1]) * 2
         w, qx, qy, qz = (m[1][0] - m[0][1]) / s, (m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s
     return [qx, qy, qz, w]
+
+
+def png_rgba(width, height, texel):
+    """An 8-bit RGBA PNG (colour type 6, no interlace) of texel(x, y) -> (r, g, b, a), row 0 on top."""
+    def chunk(kind, payload):
+        return (struct.pack(">I", len(payload)) + kind + payload +
+                struct.pack(">I", zlib.crc32(kind + payload) & 0xffffffff))
+    raw = b"".join(b"\0" + bytes(c for x in range(width) for c in texel(x, y)) for y in range(height))
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
 
 
 class Builder:
@@ -132,9 +154,33 @@ class Builder:
         self.doc["materials"].append(mat)
         return len(self.doc["materials"]) - 1
 
-    def mesh(self, name, positions, normals, indices, material):
+    def _vec2_accessor(self, values):
+        payload = b"".join(struct.pack("<2f", *v) for v in values)
+        self.doc["accessors"].append({"bufferView": self._view(payload, 34962), "componentType": 5126,
+                                      "count": len(values), "type": "VEC2"})
+        return len(self.doc["accessors"]) - 1
+
+    def texture(self, png, mag, wrap_s, wrap_t):
+        """A texture of a PNG (bytes, embedded as a data URI) with its own sampler; returns its index."""
+        self.doc.setdefault("images", []).append(
+            {"uri": "data:image/png;base64," + base64.b64encode(png).decode("ascii")})
+        self.doc.setdefault("samplers", []).append({"magFilter": mag, "minFilter": mag, "wrapS": wrap_s,
+                                                    "wrapT": wrap_t})
+        self.doc.setdefault("textures", []).append({"source": len(self.doc["images"]) - 1,
+                                                    "sampler": len(self.doc["samplers"]) - 1})
+        return len(self.doc["textures"]) - 1
+
+    def pbr_material(self, name, pbr, **extra):
+        """A glTF metallic-roughness material (no NUSSELT_brdf: the renderer's gltf_pbr)."""
+        self.doc["materials"].append(dict({"name": name, "pbrMetallicRoughness": pbr}, **extra))
+        return len(self.doc["materials"]) - 1
+
+    def mesh(self, name, positions, normals, indices, material, texcoords=()):
         pos = self._vec3_accessor(positions, True)
         nrm = self._vec3_accessor(normals, False)
+        attributes = {"POSITION": pos, "NORMAL": nrm}
+        for k, uv in enumerate(texcoords):
+            attributes["TEXCOORD_%d" % k] = self._vec2_accessor(uv)
         payload = b"".join(struct.pack("<I", i) for i in indices)
         while len(payload) % 4:
             payload += b"\0"
@@ -142,13 +188,14 @@ class Builder:
                                       "count": len(indices), "type": "SCALAR"})
         ind = len(self.doc["accessors"]) - 1
         self.doc["meshes"].append({"name": name, "primitives": [
-            {"attributes": {"POSITION": pos, "NORMAL": nrm}, "indices": ind, "material": material, "mode": 4}]})
+            {"attributes": attributes, "indices": ind, "material": material, "mode": 4}]})
         self.node({"name": name, "mesh": len(self.doc["meshes"]) - 1})
 
-    def quad(self, name, corners, material):
-        """corners in counter-clockwise order seen from the front (the emitting side)."""
+    def quad(self, name, corners, material, texcoords=()):
+        """corners in counter-clockwise order seen from the front (the emitting side); texcoords:
+        per set, the four corners' (u, v)."""
         n = normalize(cross(sub(corners[1], corners[0]), sub(corners[2], corners[0])))
-        self.mesh(name, corners, [n] * 4, [0, 1, 2, 0, 2, 3], material)
+        self.mesh(name, corners, [n] * 4, [0, 1, 2, 0, 2, 3], material, texcoords)
 
     def node(self, node):
         self.doc["nodes"].append(node)
@@ -334,6 +381,51 @@ def combined():
     b.write("combined.gltf")
 
 
+def textures():
+    b = Builder()
+    NEAREST, LINEAR, REPEAT, CLAMP, MIRROR = 9728, 9729, 10497, 33071, 33648
+    checker = b.texture(png_rgba(8, 8, lambda x, y: (230, 220, 200, 255) if (x + y) % 2 == 0 else (40, 70, 140, 255)),
+                        NEAREST, REPEAT, REPEAT)
+    # G = roughness (0.1 at the left to 1 at the right), B = metallic (0 at the back, 1 at the front)
+    gradient = b.texture(png_rgba(8, 8, lambda x, y: (0, 25 + 230 * x // 7, 255 * y // 7, 255)), LINEAR, CLAMP, CLAMP)
+    stripes = b.texture(png_rgba(4, 4, lambda x, y: (255, 230, 180, 255) if x % 2 == 0 else (60, 90, 255, 255)),
+                        NEAREST, CLAMP, CLAMP)
+    wall = b.texture(png_rgba(4, 4, lambda x, y: (40 + 60 * x, 120, 40 + 60 * y, 255)), LINEAR, MIRROR, MIRROR)
+    b.use("KHR_texture_transform")
+    floor = b.pbr_material("floor", {
+        "baseColorTexture": {"index": checker, "extensions": {"KHR_texture_transform": {"scale": [3, 3]}}},
+        "metallicRoughnessTexture": {"index": gradient}, "metallicFactor": 1.0, "roughnessFactor": 1.0})
+    back = b.pbr_material("back", {"baseColorTexture": {"index": wall, "texCoord": 1}, "metallicFactor": 0.0})
+    lamp = b.pbr_material("lamp", {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0.0},
+                          emissiveFactor=[1.0, 1.0, 1.0], emissiveTexture={"index": stripes})
+    b.doc["materials"][lamp]["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": 6.0}}
+    b.use("KHR_materials_emissive_strength")
+    unit = [[0, 1], [1, 1], [1, 0], [0, 0]]
+    b.quad("floor", [[-2, 0, 2], [2, 0, 2], [2, 0, -2], [-2, 0, -2]], floor, [unit])
+    # TEXCOORD_0 is a decoy (all zero): the wall's texture reads TEXCOORD_1, which spans [-1, 2] (mirrored)
+    b.quad("back", [[-2, 0, -2], [2, 0, -2], [2, 2, -2], [-2, 2, -2]], back,
+           [[[0, 0]] * 4, [[-1, 2], [2, 2], [2, -1], [-1, -1]]])
+    # the lamp at y = 1.6 facing down: counter-clockwise seen from below
+    b.quad("lamp", [[-0.6, 1.6, -0.6], [0.6, 1.6, -0.6], [0.6, 1.6, 0.6], [-0.6, 1.6, 0.6]], lamp, [unit])
+    b.camera("camera", (0.0, 0.9, 4.2), (0.0, 0.7, 0.0), 0.8, 1.0)
+    b.write("textures.gltf")
+
+
+def glass_slab():
+    b = Builder()
+    b.use("KHR_materials_transmission")
+    b.use("KHR_materials_ior")
+    glass = b.pbr_material("glass", {"metallicFactor": 0.0, "roughnessFactor": 0.0},
+                           extensions={"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                                       "KHR_materials_ior": {"ior": 1.5}})
+    lamp = b.material("lamp", 0.0, emission=(1.0, 1.0, 1.0))
+    b.quad("lamp", [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], lamp)
+    b.quad("top", [[-1, -1, 0.4], [1, -1, 0.4], [1, 1, 0.4], [-1, 1, 0.4]], glass)
+    b.quad("bottom", [[-1, -1, 0.2], [-1, 1, 0.2], [1, 1, 0.2], [1, -1, 0.2]], glass)
+    b.camera("camera", (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), 0.3, 1.0)
+    b.write("glass_slab.gltf")
+
+
 if __name__ == "__main__":
     furnace()
     mis()
@@ -342,3 +434,5 @@ if __name__ == "__main__":
     environment()
     env_bench(False)
     env_bench(True)
+    textures()
+    glass_slab()

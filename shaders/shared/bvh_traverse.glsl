@@ -1,6 +1,8 @@
 // bvh_traverse.glsl: ray/scene intersection against the BVH of src/scene/bvh.cpp (GLSL only;
 // included after shared/layout.h). The node encoding is documented in src/scene/bvh.h.
-// bvhClosestHit in bvh.cpp is the C++ twin of traceClosest: change both together.
+// bvhClosestHit in bvh.cpp is the C++ twin of traceClosest: change both together. (The alpha test
+// of MASK/BLEND materials, HAS_ALPHA and alphaPasses of stage_common.glsl, is GPU-only: the twin
+// answers for opaque scenes.)
 //
 // Shape of the loop (lavapipe truncates loops after 65,535 iterations per invocation, so keep
 // the iteration count low and the loops simple): one iteration per inner node visited. Each
@@ -94,7 +96,7 @@ bool traceClosest(vec3 origin, vec3 dir, float tmin, float tmax, out float t, ou
         float tt;
         float u;
         float v;
-        if (bvhHitTriangle(origin, dir, triangles.v[i], tmin, t, tt, u, v)) {
+        if (bvhHitTriangle(origin, dir, triangles.v[i], tmin, t, tt, u, v) && (!HAS_ALPHA || alphaPasses(i, u, v, origin, dir))) {
           t = tt;
           b1 = u;
           b2 = v;
@@ -109,7 +111,7 @@ bool traceClosest(vec3 origin, vec3 dir, float tmin, float tmax, out float t, ou
         float tt;
         float u;
         float v;
-        if (bvhHitTriangle(origin, dir, triangles.v[i], tmin, t, tt, u, v)) {
+        if (bvhHitTriangle(origin, dir, triangles.v[i], tmin, t, tt, u, v) && (!HAS_ALPHA || alphaPasses(i, u, v, origin, dir))) {
           t = tt;
           b1 = u;
           b2 = v;
@@ -161,7 +163,8 @@ bool traceAny(vec3 origin, vec3 dir, float tmin, float tmax) {
         float tt;
         float u;
         float v;
-        if (bvhHitTriangle(origin, dir, triangles.v[i], tmin, tmax, tt, u, v)) return true;
+        if (bvhHitTriangle(origin, dir, triangles.v[i], tmin, tmax, tt, u, v) && (!HAS_ALPHA || alphaPasses(i, u, v, origin, dir)))
+          return true;
       }
       hit0 = false;
     }
@@ -170,7 +173,8 @@ bool traceAny(vec3 origin, vec3 dir, float tmin, float tmax) {
         float tt;
         float u;
         float v;
-        if (bvhHitTriangle(origin, dir, triangles.v[i], tmin, tmax, tt, u, v)) return true;
+        if (bvhHitTriangle(origin, dir, triangles.v[i], tmin, tmax, tt, u, v) && (!HAS_ALPHA || alphaPasses(i, u, v, origin, dir)))
+          return true;
       }
       hit1 = false;
     }

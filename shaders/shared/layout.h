@@ -7,6 +7,7 @@
 #include "prelude.h"
 #include "quadtree_layout.h"
 #include "tabulated_layout.h"
+#include "texture_layout.h"
 
 SHARED_BEGIN
 
@@ -73,6 +74,8 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 #define MATERIAL_EMISSIVE 1u
 #define MATERIAL_DELTA 2u     // every component of the material is a delta model (no light samples)
 #define MATERIAL_COMBINED 4u  // a weighted sum of elementary BRDFs (GpuMaterial.components)
+#define MATERIAL_TEXTURED 8u  // a texture applies (Globals.materialTextures: GpuMaterialTextures)
+#define MATERIAL_ALPHA 16u    // alphaMode MASK or BLEND: hits are tested in traversal (trace.glsl)
 
 // ---- Combined materials ---------------------------------------------------------------------------
 // At most this many components per material: the shade stage is specialised per tuple of component
@@ -209,6 +212,9 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer QuadNodes {
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer QuadLeaves { QuadLeaf v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer TabSets { TabSet v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer TabTables { TabTable v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Textures { GpuTexture v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer MaterialTextures { GpuMaterialTextures v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer TriTexcoords { GpuTriTexcoords v[]; };
 #endif
 
 // The environment: an equirectangular (lat-long) radiance map and its sampling distribution
@@ -253,8 +259,8 @@ struct Globals {
   uint passSamples;      // samples per pixel in this pass (sample indices sampleIndex + 0 .. passSamples - 1)
   // (the uints above fill their 16-byte rows; a new row of four)
   uint environmentLight; // the environment's index in the light list, or INVALID_INDEX: no environment
-  uint reserved1;
-  uint reserved2;
+  uint texturedScene;    // 1: some material has a texture that applies (the HAS_TEXTURES stages), else 0
+  uint alphaScene;       // 1: some material has alphaMode MASK or BLEND (the HAS_ALPHA tracing stages), else 0
   uint reserved3;
   vec4 camPosition; // xyz, w = 1 for orthographic
   vec4 camRight;    // unit right * (tan(yfov/2) * aspect), or * xmag for orthographic
@@ -295,12 +301,19 @@ struct Globals {
   BUFREF(Floats) tabData;      // the CDFs of every table
   BUFREF(Floats) measured;     // measured BRDF tables (merl: MERL_TABLE_FLOATS each, brdf/merl.h)
   BUFREF(Environments) environment; // one GpuEnvironment (0 when the scene has none)
+  // glTF textures (texture_layout.h); one-entry buffers when no material is textured.
+  BUFREF(Textures) textures;   // GpuTexture records
+  BUFREF(Uints) texels;        // every image's RGBA8 texels, one uint each
+  BUFREF(MaterialTextures) materialTextures; // per material, parallel to `materials`
+  BUFREF(TriTexcoords) texcoords; // per triangle, parallel to `triangles`
+  BUFREF(Vec4s) tangents;      // per triangle 3 vec4, the corners' tangents (Scene::tangents: xyz, w = bitangent
+                               // sign), parallel to `triangles`; one entry when no material is normal-mapped
   // The top-level acceleration structure's device address, low and high 32 bits, for ray queries
   // (shaders/shared/trace.glsl with NUSSELT_RAY_QUERY); 0 when the GLSL BVH traces.
   uint tlasLow;
   uint tlasHigh;
 };
-STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 31 * 8 + 8);
+STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 36 * 8 + 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 

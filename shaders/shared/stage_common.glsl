@@ -12,6 +12,48 @@
 #include "shared/layout.h"
 #include "shared/rng.h"
 #include "shared/warp.h"
+#include "shared/texture.h"
+
+// ---- Alpha coverage (glTF alphaMode; docs/scenes.md, "Alpha") ---------------------------------
+// The tracing stages of a scene with MASK or BLEND materials test every candidate hit (constant
+// 9, set by the integrator for intersect and shadow only; false elsewhere, the tools included).
+layout(constant_id = 9) const bool HAS_ALPHA = false;
+
+// The texel buffer as a plain reference (the globals block is readonly, and a member of it cannot
+// be passed to a function parameter without that qualifier).
+Uints texelBuffer() {
+  Uints t = g.texels;
+  return t;
+}
+
+// One step of a PCG-style integer hash (O'Neill's RXS-M-XS output on an LCG step), mixing in v.
+uint alphaHashStep(uint h, uint v) {
+  h = (h ^ v) * 747796405u + 2891336453u;
+  h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
+  return (h >> 22u) ^ h;
+}
+
+// Whether a candidate hit of triangle tri at barycentrics (b1, b2) of the ray (origin, dir)
+// counts. OPAQUE: always. MASK: alpha >= alphaCutoff. BLEND: with probability alpha (stochastic
+// transparency), decided by a hash of the ray and the triangle, so a render is a function of its
+// seed. alpha = baseColorFactor.a x the base-colour texture's alpha at the hit.
+bool alphaPasses(uint tri, float b1, float b2, vec3 origin, vec3 dir) {
+  uint material = g.shading.v[tri].info.x;
+  if ((g.materials.v[material].info.y & MATERIAL_ALPHA) == 0u) return true;
+  GpuMaterialTextures T = g.materialTextures.v[material];
+  float alpha = T.baseColorFactor.w;
+  if (T.alpha.y != INVALID_INDEX)
+    alpha *= textureAtHit(texelBuffer(), g.textures.v[T.alpha.y], g.texcoords.v[tri], b1, b2).w;
+  if (T.alpha.x == ALPHA_MASK) return alpha >= T.factors.w;
+  uint h = alphaHashStep(tri * 0x9e3779b9u, floatBitsToUint(origin.x));
+  h = alphaHashStep(h, floatBitsToUint(origin.y));
+  h = alphaHashStep(h, floatBitsToUint(origin.z));
+  h = alphaHashStep(h, floatBitsToUint(dir.x));
+  h = alphaHashStep(h, floatBitsToUint(dir.y));
+  h = alphaHashStep(h, floatBitsToUint(dir.z));
+  return float(h >> 8u) * (1.0f / 16777216.0f) < alpha;
+}
+
 #include "shared/trace.glsl"
 #include "shared/envmap.h"
 
@@ -21,6 +63,8 @@ layout(local_size_x = WORKGROUP_SIZE) in;
 // render builds only what its scene needs (lavapipe's Mesa 22.3 ran every branch body a subgroup
 // reached, taken or not; reference/lavapipe.md). Constant 7: after the shade stages' own 0..6.
 layout(constant_id = 7) const bool HAS_ENVIRONMENT = true;
+// Likewise the texture lookups of a scene without textures (Globals.texturedScene; constant 8).
+layout(constant_id = 8) const bool HAS_TEXTURES = true;
 
 // ---- Queues ---------------------------------------------------------------------------------
 
@@ -75,6 +119,23 @@ vec3 offsetRay(vec3 p, vec3 n) {
 vec3 triangleNormalUnnormalized(uint tri) {
   GpuTriangle t = g.triangles.v[tri];
   return cross(t.e1.xyz, t.e2.xyz);
+}
+
+// ---- Textures (shared/texture.h; docs/scenes.md, "Textures") ------------------------------------
+
+// Texture `tex` (an index into g.textures) at barycentrics (b1, b2) of triangle tri.
+vec4 sceneTexture(uint tex, uint tri, float b1, float b2) {
+  return textureAtHit(texelBuffer(), g.textures.v[tex], g.texcoords.v[tri], b1, b2);
+}
+
+// The emitted radiance of `material` at barycentrics (b1, b2) of triangle tri: its emission times
+// its emissive texture when one applies. Light selection and its pdf use the emission factor only
+// (src/render/device_scene.cpp), so the texture enters as a value at the sampled or hit point and
+// both estimators (light sampling and BSDF sampling, with MIS) stay unbiased.
+vec3 texturedEmission(uint material, vec3 emission, uint tri, float b1, float b2) {
+  if (!HAS_TEXTURES || (g.materials.v[material].info.y & MATERIAL_TEXTURED) == 0u) return emission;
+  uint tex = g.materialTextures.v[material].maps.z;
+  return tex == INVALID_INDEX ? emission : emission * sceneTexture(tex, tri, b1, b2).xyz;
 }
 
 // ---- Lights ---------------------------------------------------------------------------------
@@ -138,7 +199,9 @@ bool sampleLight(vec3 x, float uSelect, vec2 uPoint, out LightSample ls) {
     if (cosLight <= 0.0f) return false;
     ls.pdf = pSelect * dist2 / (0.5f * area2 * cosLight);
     uint material = g.shading.v[tri].info.x;
-    ls.value = g.materials.v[material].emission.xyz / ls.pdf;
+    vec3 Le = g.materials.v[material].emission.xyz;
+    if (HAS_TEXTURES) Le = texturedEmission(material, Le, tri, b.x, b.y);
+    ls.value = Le / ls.pdf;
     ls.dist = dist;
     return ls.pdf > 0.0f && isFinite(ls.pdf);
   }

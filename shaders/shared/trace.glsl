@@ -4,6 +4,8 @@
 //     tmin < t < tmax; b1, b2 are the barycentrics of v1 = v0 + e1 and v2 = v0 + e2 and tri the
 //     index into g.triangles / g.shading. False (t = tmax, tri = INVALID_INDEX) on a miss.
 //   traceAny(origin, dir, tmin, tmax): whether anything lies in (tmin, tmax) (shadow rays).
+// Both skip hits that alphaPasses (stage_common.glsl) rejects when HAS_ALPHA: MASK and BLEND
+// materials (docs/scenes.md, "Alpha").
 // Which traversal answers is chosen at compile time: with NUSSELT_RAY_QUERY defined (the *_rq
 // modules, CMakeLists.txt), the device's ray queries against the acceleration structures of
 // DeviceScene (one bottom level over the scene's triangles in g.triangles order, one top-level
@@ -35,9 +37,16 @@ bool traceClosest(vec3 origin, vec3 dir, float tmin, float tmax, out float t, ou
   tri = INVALID_INDEX;
   if (g.triangleCount == 0u || traceRayInvalid(origin, dir, tmin, tmax)) return false;
   rayQueryEXT rq;
-  rayQueryInitializeEXT(rq, traceScene(), gl_RayFlagsOpaqueEXT, 0xffu, origin, tmin, dir, tmax);
-  // Opaque geometry: the traversal commits the closest hit itself and proceeds once.
+  // Opaque geometry: the traversal commits the closest hit itself and proceeds once. With alpha
+  // (HAS_ALPHA) every triangle is a candidate, committed when alphaPasses.
+  rayQueryInitializeEXT(rq, traceScene(), HAS_ALPHA ? gl_RayFlagsNoOpaqueEXT : gl_RayFlagsOpaqueEXT, 0xffu, origin,
+                        tmin, dir, tmax);
   while (rayQueryProceedEXT(rq)) {
+    if (HAS_ALPHA && rayQueryGetIntersectionTypeEXT(rq, false) == gl_RayQueryCandidateIntersectionTriangleEXT) {
+      vec2 c = rayQueryGetIntersectionBarycentricsEXT(rq, false);
+      if (alphaPasses(uint(rayQueryGetIntersectionPrimitiveIndexEXT(rq, false)), c.x, c.y, origin, dir))
+        rayQueryConfirmIntersectionEXT(rq);
+    }
   }
   if (rayQueryGetIntersectionTypeEXT(rq, true) != gl_RayQueryCommittedIntersectionTriangleEXT) return false;
   t = rayQueryGetIntersectionTEXT(rq, true);
@@ -51,9 +60,15 @@ bool traceClosest(vec3 origin, vec3 dir, float tmin, float tmax, out float t, ou
 bool traceAny(vec3 origin, vec3 dir, float tmin, float tmax) {
   if (g.triangleCount == 0u || traceRayInvalid(origin, dir, tmin, tmax)) return false;
   rayQueryEXT rq;
-  rayQueryInitializeEXT(rq, traceScene(), gl_RayFlagsOpaqueEXT | gl_RayFlagsTerminateOnFirstHitEXT, 0xffu, origin,
-                        tmin, dir, tmax);
+  rayQueryInitializeEXT(rq, traceScene(),
+                        (HAS_ALPHA ? gl_RayFlagsNoOpaqueEXT : gl_RayFlagsOpaqueEXT) | gl_RayFlagsTerminateOnFirstHitEXT,
+                        0xffu, origin, tmin, dir, tmax);
   while (rayQueryProceedEXT(rq)) {
+    if (HAS_ALPHA && rayQueryGetIntersectionTypeEXT(rq, false) == gl_RayQueryCandidateIntersectionTriangleEXT) {
+      vec2 c = rayQueryGetIntersectionBarycentricsEXT(rq, false);
+      if (alphaPasses(uint(rayQueryGetIntersectionPrimitiveIndexEXT(rq, false)), c.x, c.y, origin, dir))
+        rayQueryConfirmIntersectionEXT(rq);
+    }
   }
   return rayQueryGetIntersectionTypeEXT(rq, true) == gl_RayQueryCommittedIntersectionTriangleEXT;
 }

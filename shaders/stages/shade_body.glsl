@@ -36,6 +36,58 @@ float componentMisPdf(uint model, GpuComponent C, float c, vec3 wo, vec3 wi) {
 }
 #endif
 
+// ---- evalParams: the material's parameters at the hit (textures; docs/scenes.md, "Textures") ----
+// params: the model's parameters (the material's factors on entry); emission: its emitted
+// radiance. gltf_pbr: baseColor x baseColorTexture.rgb (sRGB decoded), metallic x B and roughness
+// x G of metallicRoughnessTexture; any model: emission x emissiveTexture.rgb (sRGB decoded).
+void evalParams(uint model, uint material, uint tri, float b1, float b2, inout BrdfParams params,
+                inout vec3 emission) {
+  GpuMaterialTextures T = g.materialTextures.v[material];
+  GpuTriTexcoords uv = g.texcoords.v[tri];
+  if (T.maps.z != INVALID_INDEX) emission *= textureAtHit(texelBuffer(), g.textures.v[T.maps.z], uv, b1, b2).xyz;
+  if (model == MODEL_GLTF_PBR) {
+    if (T.maps.x != INVALID_INDEX) {
+      vec4 c = textureAtHit(texelBuffer(), g.textures.v[T.maps.x], uv, b1, b2);
+      for (uint k = 0u; k < 3u; ++k)
+        params.v[(GLTF_PBR_BASE_COLOR + k) / 4u][(GLTF_PBR_BASE_COLOR + k) % 4u] *= c[k];
+    }
+    if (T.maps.y != INVALID_INDEX) {
+      vec4 mr = textureAtHit(texelBuffer(), g.textures.v[T.maps.y], uv, b1, b2);
+      params.v[GLTF_PBR_METALLIC / 4u][GLTF_PBR_METALLIC % 4u] *= mr.z;
+      params.v[GLTF_PBR_ROUGHNESS / 4u][GLTF_PBR_ROUGHNESS % 4u] *= mr.y;
+    }
+  }
+}
+
+// ---- The normal map (docs/scenes.md, "Normal maps") ----
+// The shading normal from material's normal texture at the hit, or ns (the interpolated shading
+// normal) unchanged when there is none. Frame: the interpolated tangent made orthogonal to ns
+// (Gram-Schmidt), bitangent w cross(ns, t) with corner 0's sign w; the texel maps [0, 1] to
+// [-1, 1], x and y times normalScale, and n = x t + y b + z ns. The rule that keeps paths above
+// the geometric surface starts here: the mapped normal replaces ns only when it lies on the same
+// side of the geometric surface (ngFront) as ns; main() then orients it to the viewer's side and
+// falls back to the geometric normal when the viewer is below its hemisphere.
+vec3 normalMapped(uint material, uint tri, float b1, float b2, vec3 ns, vec3 ngFront) {
+  uint tex = g.materialTextures.v[material].maps.w;
+  if (tex == INVALID_INDEX) return ns;
+  float scale = g.materialTextures.v[material].factors.z;
+  vec4 t0 = g.tangents.v[3u * tri];
+  vec4 t1 = g.tangents.v[3u * tri + 1u];
+  vec4 t2 = g.tangents.v[3u * tri + 2u];
+  vec3 t = (1.0f - b1 - b2) * t0.xyz + b1 * t1.xyz + b2 * t2.xyz;
+  t -= dot(t, ns) * ns;
+  float tl = length(t);
+  if (!(tl > 1e-6f)) return ns;
+  t /= tl;
+  vec3 bt = (t0.w < 0.0f ? -1.0f : 1.0f) * cross(ns, t);
+  vec3 c = sceneTexture(tex, tri, b1, b2).xyz * 2.0f - 1.0f;
+  vec3 n = c.x * scale * t + c.y * scale * bt + c.z * ns;
+  float nl = length(n);
+  if (!(nl > 1e-6f)) return ns;
+  n /= nl;
+  return dot(n, ngFront) * dot(ns, ngFront) > 0.0f ? n : ns;
+}
+
 void main() {
   uint idx = gl_GlobalInvocationID.x;
   uint queue = QUEUE_SHADE_BASE + pc.modelSlot;
@@ -63,6 +115,14 @@ void main() {
   vec3 ngFront = normalize(cross(T.e1.xyz, T.e2.xyz));
   vec3 ns = normalize((1.0f - hit.y - hit.z) * S.n0.xyz + hit.y * S.n1.xyz + hit.z * S.n2.xyz);
   GpuMaterial M = g.materials.v[S.info.x];
+  // evalParams: the parameters and emission at this point (differ from M's only where textured).
+  vec3 Le = M.emission.xyz;
+#if SHADE_COMBINED
+  if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) evalParams(INVALID_INDEX, S.info.x, tri, hit.y, hit.z, M.params, Le);
+#else
+  if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) evalParams(MODEL_ID, S.info.x, tri, hit.y, hit.z, M.params, Le);
+#endif
+  if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) ns = normalMapped(S.info.x, tri, hit.y, hit.z, ns, ngFront);
   vec4 throughput = g.pathThroughput.v[path];
   vec3 beta = throughput.xyz;
   float etaScale = throughput.w;
@@ -80,7 +140,7 @@ void main() {
         w = powerHeuristic(prevPdf, lightPdf);
       }
     }
-    L += beta * M.emission.xyz * w;
+    L += beta * Le * w;
   }
 
   // ---- Local frame: surfaces are two-sided, shade the side the ray came from ----

@@ -7,6 +7,7 @@
 
 #include "../../shaders/shared/layout.h"
 #include "render/environment.h"
+#include "render/texture_table.h"
 #include "scene/bvh.h"
 #include "util/error.h"
 
@@ -65,6 +66,14 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene, TraversalStructur
   std::vector<GpuTriShading> shading(std::max<std::size_t>(triCount, 1));
   std::vector<GpuLight> lights;
   std::vector<double> weights;
+  // Texture coordinates in the same order, only for a scene with textures (absent sets read (0, 0)).
+  const bool textured = sceneUsesTextures(scene);
+  std::vector<shared::GpuTriTexcoords> texcoords(textured ? std::max<std::size_t>(triCount, 1) : 1);
+  const bool has0 = scene.texcoords0.size() == scene.positions.size();
+  const bool has1 = scene.texcoords1.size() == scene.positions.size();
+  // Tangents (3 vec4 per triangle) only for a scene with a normal map.
+  const bool normalMapped = sceneUsesNormalMaps(scene);
+  std::vector<glm::vec4> tangents(normalMapped ? 3 * std::max<std::size_t>(triCount, 1) : 1, glm::vec4(0.0f));
   std::vector<float> vertices;  // the bottom level's input: 3 vertices per triangle, in g.triangles order
   if (structures.accelerationStructures) vertices.reserve(9 * triCount);
   glm::vec3 lo(INFINITY), hi(-INFINITY);
@@ -83,6 +92,18 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene, TraversalStructur
     shading[k].n0 = v4(scene.normals[3 * src]);
     shading[k].n1 = v4(scene.normals[3 * src + 1]);
     shading[k].n2 = v4(scene.normals[3 * src + 2]);
+    if (textured) {
+      glm::vec2 a[3]{}, b[3]{};
+      for (int c = 0; c < 3; ++c) {
+        if (has0) a[c] = scene.texcoords0[3 * src + c];
+        if (has1) b[c] = scene.texcoords1[3 * src + c];
+      }
+      texcoords[k].a = glm::vec4(a[0], a[1]);
+      texcoords[k].b = glm::vec4(a[2], b[0]);
+      texcoords[k].c = glm::vec4(b[1], b[2]);
+    }
+    if (normalMapped)
+      for (int c = 0; c < 3; ++c) tangents[3 * k + c] = scene.tangents[3 * src + c];
     std::uint32_t mat = scene.triangleMaterial[src];
     std::uint32_t lightIndex = INVALID_INDEX;
     if (scene.materials[mat].emits()) {
@@ -179,6 +200,8 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene, TraversalStructur
   make(m_shading, shading.size() * sizeof(GpuTriShading), "triangle shading", shading.data());
   make(m_lightBuffer, lights.size() * sizeof(GpuLight), "light", lights.data());
   make(m_lightCdf, cdf.size() * sizeof(float), "light CDF", cdf.data());
+  make(m_texcoords, texcoords.size() * sizeof(shared::GpuTriTexcoords), "triangle texture coordinates", texcoords.data());
+  make(m_tangents, tangents.size() * sizeof(glm::vec4), "triangle tangents", tangents.data());
 
   if (env.emits()) {
     make(m_envTexels, env.texels.size() * sizeof(glm::vec4), "environment texels", env.texels.data());
@@ -217,13 +240,13 @@ void DeviceScene::release() {
   vk::destroyAccelerationStructure(m_ctx, m_tlas);
   vk::destroyAccelerationStructure(m_ctx, m_blas);
   for (vk::Buffer* b : {&m_bvh, &m_tris, &m_shading, &m_lightBuffer, &m_lightCdf, &m_envTexels, &m_envDistribution,
-                        &m_envStruct})
+                        &m_envStruct, &m_texcoords, &m_tangents})
     vk::destroyBuffer(m_ctx, *b);
 }
 
 std::uint64_t DeviceScene::deviceBytes() const {
   return m_bvh.size + m_tris.size + m_shading.size + m_lightBuffer.size + m_lightCdf.size + m_envTexels.size +
-         m_envDistribution.size + m_envStruct.size + accelerationBytes();
+         m_envDistribution.size + m_envStruct.size + m_texcoords.size + m_tangents.size + accelerationBytes();
 }
 
 void DeviceScene::fillGlobals(shared::Globals& g) const {
@@ -238,6 +261,8 @@ void DeviceScene::fillGlobals(shared::Globals& g) const {
   g.environmentLight = m_environmentLight;
   g.environment = m_envStruct.buffer ? m_envStruct.address : 0;
   g.triangleCount = static_cast<std::uint32_t>(m_triangles);
+  g.texcoords = m_texcoords.address;
+  g.tangents = m_tangents.address;
   g.tlasLow = static_cast<std::uint32_t>(m_tlas.address);
   g.tlasHigh = static_cast<std::uint32_t>(m_tlas.address >> 32);
 }

@@ -70,6 +70,8 @@ class DeviceScene {
   std::uint32_t m_environmentLight = 0xffffffffu;  // index in the light list, INVALID_INDEX: none
   vk::Buffer m_bvh, m_tris, m_shading, m_lightBuffer, m_lightCdf;
   vk::Buffer m_envTexels, m_envDistribution, m_envStruct;  // empty without an environment
+  vk::Buffer m_texcoords;  // GpuTriTexcoords per triangle; one entry when the scene has no textures
+  vk::Buffer m_tangents;   // 3 tangents (vec4) per triangle; one entry without normal maps
   vk::AccelerationStructure m_blas, m_tlas;
 };
 

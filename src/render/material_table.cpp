@@ -9,6 +9,7 @@
 #include "brdf/albedo.h"
 #include "brdf/merl.h"
 #include "quadtree/sampler_tables.h"
+#include "render/texture_table.h"
 #include "sampling/tabulated.h"
 #include "util/error.h"
 
@@ -93,7 +94,9 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     for (std::size_t i = 0; i < scene.materials.size(); ++i) {
       if (!used[i]) continue;
       const Material& m = scene.materials[i];
-      if (!m.combined() && !modelById(m.model).delta) {
+      // A texture that varies the BRDF's parameters over the surface: no one table fits, the
+      // strategy falls back to cosine (INVALID_INDEX; docs/scenes.md, "Textures").
+      if (!m.combined() && !modelById(m.model).delta && !textureUse(m, scene).paramsVary()) {
         toBuild.push_back({m.model, m.params});
         uses.push_back({static_cast<std::uint32_t>(i), -1});
       }
@@ -163,6 +166,8 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     for (const MaterialComponent& c : src.components) allDelta = allDelta && modelById(c.model).delta;
     if (src.combined() ? allDelta : modelById(src.model).delta) flags |= MATERIAL_DELTA;
     if (src.combined()) flags |= MATERIAL_COMBINED;
+    if (used[i] && textureUse(src, scene).any()) flags |= MATERIAL_TEXTURED;
+    if (used[i] && textureUse(src, scene).alpha) flags |= MATERIAL_ALPHA;
     const std::uint32_t material = static_cast<std::uint32_t>(i);
     dst.info = glm::uvec4(src.combined() ? src.components[0].model : src.model, flags,
                           src.combined() ? INVALID_INDEX : setFor(material, -1), slot);
@@ -204,6 +209,14 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
   make(m_tabSets, tab.sets.size(), sizeof(shared::TabSet), "tabulated sets", tab.sets.data());
   make(m_tabTables, tab.tables.size(), sizeof(shared::TabTable), "tabulated tables", tab.tables.data());
   make(m_tabData, tab.data.size(), sizeof(float), "tabulated cdfs", tab.data.data());
+  // Textures: one-entry buffers when the scene has none.
+  const TextureData textures = buildTextureData(scene);
+  m_textured = !textures.materials.empty();
+  m_alpha = sceneUsesAlpha(scene);
+  make(m_textures, textures.textures.size(), sizeof(shared::GpuTexture), "textures", textures.textures.data());
+  make(m_texels, textures.texels.size(), sizeof(std::uint32_t), "texels", textures.texels.data());
+  make(m_materialTextures, textures.materials.size(), sizeof(shared::GpuMaterialTextures), "material textures",
+       textures.materials.data());
   m_measured = vk::createBuffer(m_ctx, std::max<std::size_t>(measuredSlots.size() * MERL_TABLE_FLOATS, 1) * sizeof(float), 0,
                                 false, "measured tables");
   for (std::size_t k = 0; k < measuredSlots.size(); ++k) {
@@ -216,14 +229,14 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
 
 MaterialTable::~MaterialTable() {
   for (vk::Buffer* b : {&m_materials, &m_components, &m_quadSets, &m_quadTables, &m_quadNodes, &m_quadLeaves,
-                        &m_tabSets, &m_tabTables, &m_tabData, &m_measured})
+                        &m_tabSets, &m_tabTables, &m_tabData, &m_measured, &m_textures, &m_texels, &m_materialTextures})
     vk::destroyBuffer(m_ctx, *b);
 }
 
 std::uint64_t MaterialTable::deviceBytes() const {
   std::uint64_t total = 0;
   for (const vk::Buffer* b : {&m_materials, &m_components, &m_quadSets, &m_quadTables, &m_quadNodes, &m_quadLeaves,
-                              &m_tabSets, &m_tabTables, &m_tabData, &m_measured})
+                              &m_tabSets, &m_tabTables, &m_tabData, &m_measured, &m_textures, &m_texels, &m_materialTextures})
     total += b->size;
   return total;
 }
@@ -239,6 +252,11 @@ void MaterialTable::fillGlobals(shared::Globals& g) const {
   g.tabTables = m_tabTables.address;
   g.tabData = m_tabData.address;
   g.measured = m_measured.address;
+  g.textures = m_textures.address;
+  g.texels = m_texels.address;
+  g.materialTextures = m_materialTextures.address;
+  g.texturedScene = m_textured ? 1u : 0u;
+  g.alphaScene = m_alpha ? 1u : 0u;
   g.materialCount = static_cast<std::uint32_t>(std::max<std::size_t>(m_materialCount, 1));
 }
 

@@ -58,6 +58,9 @@ class MaterialTable {
   vk::Buffer m_quadSets, m_quadTables, m_quadNodes, m_quadLeaves;
   vk::Buffer m_tabSets, m_tabTables, m_tabData;
   vk::Buffer m_measured;  // measured BRDF tables (merl), MERL_TABLE_FLOATS floats each
+  bool m_textured = false;  // some used material has a texture that applies, or alpha
+  bool m_alpha = false;     // some used material has alphaMode MASK or BLEND
+  vk::Buffer m_textures, m_texels, m_materialTextures;  // texture_table.h; one entry each without textures
 };
 
 }  // namespace nusselt

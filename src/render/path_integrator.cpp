@@ -75,6 +75,9 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   g.pathCapacity = m_capacity;
   // The escape stage exists only for scenes with an environment (the device scene set it up).
   m_hasEscape = g.environmentLight != INVALID_INDEX;
+  // Texture code only in the shade stages of a scene with textures (the material table set it).
+  m_hasTextures = g.texturedScene != 0u;
+  m_hasAlpha = g.alphaScene != 0u;
 
   auto t0 = std::chrono::steady_clock::now();
   createPipelines();
@@ -129,9 +132,13 @@ void PathIntegrator::createPipelines() {
   // The tracing stages' module for the traversal (the Renderer resolved Auto): <stage>_rq with ray
   // queries, <stage> with the GLSL BVH (CMakeLists.txt). Only the used one is compiled.
   const std::string tracing = m_settings.traversal == Traversal::RayQuery ? "_rq" : "";
-  m_intersect = vk::createComputePipeline(m_ctx, layout, "intersect" + tracing);
+  // Scenes with alpha (MASK or BLEND) test each candidate hit (HAS_ALPHA, constant 9, after
+  // HAS_ENVIRONMENT and HAS_TEXTURES); the others keep the tracing stages without that code.
+  std::vector<std::uint32_t> traceSpec;
+  if (m_hasAlpha) traceSpec = {0u, 0u, 0u, 0u, 0u, 0u, 0u, m_hasEscape ? 1u : 0u, m_hasTextures ? 1u : 0u, 1u};
+  m_intersect = vk::createComputePipeline(m_ctx, layout, "intersect" + tracing, traceSpec);
   if (m_hasEscape) m_escape = vk::createComputePipeline(m_ctx, layout, "escape");
-  m_shadow = vk::createComputePipeline(m_ctx, layout, "shadow" + tracing);
+  m_shadow = vk::createComputePipeline(m_ctx, layout, "shadow" + tracing, traceSpec);
   m_accumulate = vk::createComputePipeline(m_ctx, layout, "accumulate");
   // Only the models (and combinations) this scene uses: one specialised shade pipeline each,
   // created on all cores (drivers compile at creation; lavapipe takes ~0.3 s per shade pipeline,
@@ -157,6 +164,7 @@ void PathIntegrator::createPipelines() {
           // lacks are ignored by Vulkan.
           spec.resize(7, 0u);
           spec.push_back(m_hasEscape ? 1u : 0u);
+          spec.push_back(m_hasTextures ? 1u : 0u);  // constant 8: HAS_TEXTURES
           // One module per strategy (CMakeLists.txt): shade_sN / shade_combined_sN.
           const std::string module = std::string(key[0] > 0 ? "shade_combined" : "shade") + "_s" + std::to_string(sampler);
           m_shade[s] = vk::createComputePipeline(m_ctx, layout, module, spec);

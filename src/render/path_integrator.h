@@ -65,6 +65,8 @@ class PathIntegrator : public Integrator {
 
   vk::ComputePipeline m_camera, m_submit, m_intersect, m_escape, m_shadow, m_accumulate;
   bool m_hasEscape = false;
+  bool m_hasTextures = false;  // spec constant HAS_TEXTURES of the shade stages
+  bool m_hasAlpha = false;     // spec constant HAS_ALPHA of the tracing stages
   std::vector<vk::ComputePipeline> m_shade;  // one per slot
   VkCommandBuffer m_cmd = VK_NULL_HANDLE;
   VkFence m_fence = VK_NULL_HANDLE;

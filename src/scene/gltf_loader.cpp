@@ -680,8 +680,8 @@ class Converter {
     if (!notRendered_.empty()) {
       std::string list;
       for (const std::string& f : notRendered_) list += (list.empty() ? "" : ", ") + f;
-      warnOnce("read but not rendered yet: " + list + " (materials render with their constant factors, opaque "
-               "and reflecting only)");
+      warnOnce("read but not rendered yet: " + list + " (rendered as if absent: opaque, reflecting only, "
+               "without those textures)");
     }
     if (flatUvTangents_ > 0)
       warnOnce(str(flatUvTangents_) + " triangle corner(s) of normal-mapped primitives have texture coordinates of "
@@ -1194,6 +1194,7 @@ class Converter {
                              {"metallic", factor(pbr.metallicFactor, "metallicFactor")},
                              {"roughness", factor(pbr.roughnessFactor, "roughnessFactor")}},
                             name_ + ": " + field);
+      transmissiveMaterial(m, name_ + ": " + field);
     }
 
     const std::vector<double>& e = gm.emissiveFactor;
@@ -1216,6 +1217,7 @@ class Converter {
     if (!std::isfinite(emission.x) || !std::isfinite(emission.y) || !std::isfinite(emission.z))
       fail(field + ": emissiveFactor x emissiveStrength overflows");
     m.emission = glm::vec3(emission);
+    warnUnrenderedTextures(m);
     return m;
   }
 
@@ -1243,8 +1245,6 @@ class Converter {
     m.emissiveTexture = textureRef(viewOf(gm.emissiveTexture), field + ".emissiveTexture", ColorSpace::Srgb);
     if (gm.occlusionTexture.index != -1)
       warnOnce("occlusionTexture is ignored: a path tracer computes occlusion itself (" + field + ")");
-    bool textured = m.baseColorTexture.present() || m.metallicRoughnessTexture.present() ||
-                    m.normalTexture.present() || m.emissiveTexture.present();
 
     if (gm.alphaMode == "OPAQUE" || gm.alphaMode.empty()) m.alphaMode = AlphaMode::Opaque;
     else if (gm.alphaMode == "MASK") m.alphaMode = AlphaMode::Mask;
@@ -1254,7 +1254,6 @@ class Converter {
       fail(field + ".alphaCutoff: " + fmt(gm.alphaCutoff) + " is not a finite number >= 0");
     m.alphaCutoff = float(std::min(gm.alphaCutoff, 2.0));  // above 1 all alike: nothing passes
     m.doubleSided = gm.doubleSided;
-    if (m.alphaMode != AlphaMode::Opaque) notRenderedYet("alphaMode MASK/BLEND");
 
     auto extension = [&](const char* name) -> const tinygltf::Value* {
       auto it = gm.extensions.find(name);
@@ -1274,16 +1273,19 @@ class Converter {
       if (t->Has("transmissionTexture")) {
         m.transmissionTexture = textureRef(viewOf(t->Get("transmissionTexture"), f + ".transmissionTexture"),
                                            f + ".transmissionTexture", ColorSpace::Linear);
-        textured = textured || m.transmissionTexture.present();
       }
-      notRenderedYet("KHR_materials_transmission");
+      // Rendered (convertMaterial, transmissiveMaterial) unless NUSSELT_brdf sets the BRDF.
+      if (gm.extensions.count("NUSSELT_brdf")) notRenderedYet("KHR_materials_transmission with NUSSELT_brdf");
     }
     if (const tinygltf::Value* t = extension("KHR_materials_ior")) {
       const std::string f = field + " KHR_materials_ior";
       double ior = number(*t, "ior", f, 1.5);
       if (!std::isfinite(ior) || ior < 1 || ior > 100) fail(f + ".ior: " + fmt(ior) + " is not in [1, 100]");
       m.ior = float(ior);
-      notRenderedYet("KHR_materials_ior");
+      // Rendered as the dielectric's index of a transmitting material; not in the reflection
+      // (gltf_pbr's f0 stays 0.04).
+      if (!(m.transmissionFactor > 0) || gm.extensions.count("NUSSELT_brdf"))
+        notRenderedYet("KHR_materials_ior (used only with KHR_materials_transmission)");
     }
     if (const tinygltf::Value* t = extension("KHR_materials_volume")) {
       const std::string f = field + " KHR_materials_volume";
@@ -1307,7 +1309,43 @@ class Converter {
       }
       notRenderedYet("KHR_materials_volume");
     }
-    if (textured) notRenderedYet("textures");
+  }
+
+  // KHR_materials_transmission as smooth transmission (docs/scenes.md, "Transmission"): a combined
+  // material, gltf_pbr with weight 1 - w and the smooth dielectric of index ior (clamped to the
+  // model's [0.1, 10]) with weight w = transmissionFactor x (1 - metallic): the dielectric's
+  // Fresnel reflection and the gltf_pbr component's reflection together reflect as gltf_pbr
+  // alone, and the gltf_pbr diffuse lobe is scaled by 1 - w, as the extension's mix of diffuse and
+  // transmission does. w = 1: the dielectric alone.
+  void transmissiveMaterial(Material& m, const std::string& context) {
+    const float w = m.transmissionFactor * (1.0f - m.metallicFactor);
+    if (!(w > 0.0f)) return;
+    BrdfParams glass = packParams(*findModel("dielectric"), {{"eta", ParamValue::num(std::min(m.ior, 10.0f))}},
+                                  context + " (transmission)");
+    if (w >= 1.0f) {
+      m.model = MODEL_DIELECTRIC;
+      m.params = glass;
+      return;
+    }
+    MaterialComponent base;
+    base.model = MODEL_GLTF_PBR;
+    base.weight = 1.0f - w;
+    base.params = m.params;
+    MaterialComponent clear;
+    clear.model = MODEL_DIELECTRIC;
+    clear.weight = w;
+    clear.params = glass;
+    m.components = {base, clear};
+  }
+
+  // The textures the renderer does not apply yet (src/render/texture_table.h applies baseColor and
+  // metallicRoughness of gltf_pbr materials and every emissive and normal texture).
+  void warnUnrenderedTextures(const Material& m) {
+    if (m.transmissionTexture.present()) notRenderedYet("transmissionTexture");
+    if ((m.combined() || m.model != MODEL_GLTF_PBR) &&
+        (m.baseColorTexture.present() || m.metallicRoughnessTexture.present()))
+      notRenderedYet("baseColorTexture/metallicRoughnessTexture RGB of materials other than a single gltf_pbr "
+                     "(NUSSELT_brdf models, combined or transmissive materials)");
   }
 
   std::uint32_t defaultMaterial() {

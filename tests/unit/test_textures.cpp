@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "../../shaders/shared/brdf/dispatch.h"
 #include "io/image_decode.h"
 #include "scene/gltf_loader.h"
 #include "scene/tangents.h"
@@ -353,7 +354,8 @@ TEST(GltfTextures, ImagesAreDecodedOnceAndSlotsSayTheirColourSpace) {
   EXPECT_EQ(im.rgba[4 * (2 * 5 + 3) + 3], a8(3, 2));
   EXPECT_EQ(s.images[1].rgba[4 * 4], grey8(4, 0));
   EXPECT_TRUE(hasWarning(s, "occlusionTexture is ignored"));
-  EXPECT_TRUE(hasWarning(s, "read but not rendered yet: textures"));
+  // baseColor, metallicRoughness, emissive and normal textures render: no warning about them.
+  EXPECT_FALSE(hasWarning(s, "read but not rendered yet"));
   // Without a sampler: REPEAT and LINEAR (glTF's "auto" filtering); no transform: identity.
   EXPECT_EQ(m.baseColorTexture.wrapS, WrapMode::Repeat);
   EXPECT_EQ(m.baseColorTexture.minFilter, FilterMode::Linear);
@@ -476,8 +478,10 @@ TEST(GltfTextures, AlphaSidednessTransmissionIorVolume) {
   EXPECT_FLOAT_EQ(m.thicknessFactor, 0.02f);
   EXPECT_FLOAT_EQ(m.attenuationDistance, 0.5f);
   EXPECT_FLOAT_EQ(m.attenuationColor.y, 0.5f);
-  EXPECT_TRUE(hasWarning(s, "read but not rendered yet: KHR_materials_ior, KHR_materials_transmission, "
-                            "KHR_materials_volume, alphaMode MASK/BLEND, textures"));
+  EXPECT_TRUE(hasWarning(s, "read but not rendered yet: KHR_materials_volume, transmissionTexture ("));
+  // glTF's default metallicFactor 1: a metal does not transmit, the material stays gltf_pbr.
+  EXPECT_EQ(m.model, MODEL_GLTF_PBR);
+  EXPECT_FALSE(m.combined());
   // Defaults.
   Json d = texturedQuad();
   d["materials"][0] = Json::parse(R"({"extensions": {"KHR_materials_volume": {}}})");
@@ -508,6 +512,33 @@ TEST(GltfTextures, AlphaSidednessTransmissionIorVolume) {
   EXPECT_HAS(errorWith(R"({"extensions": {"KHR_materials_transmission": {"transmissionTexture": {"index": 9}}}})"),
              "KHR_materials_transmission.transmissionTexture.index: 9 is out of range");
   EXPECT_HAS(errorWith(R"({"normalTexture": {"index": 0, "scale": 1e300}})"), "normalTexture.scale");
+}
+
+// KHR_materials_transmission renders as smooth transmission: gltf_pbr with weight 1 - w plus the
+// dielectric of index ior with weight w = transmissionFactor x (1 - metallic); w = 1: the
+// dielectric alone. Neither extension is then named in the "not rendered" warning.
+TEST(GltfTextures, TransmissionBecomesTheDielectric) {
+  Json j = texturedQuad();
+  j["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior"};
+  j["materials"][0] = Json::parse(R"({"name": "frosted", "pbrMetallicRoughness": {"metallicFactor": 0.2,
+    "roughnessFactor": 0.3}, "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.75},
+                                           "KHR_materials_ior": {"ior": 1.33}}})");
+  Scene s = loadJson(j);
+  const Material& m = s.materials[0];
+  ASSERT_EQ(m.components.size(), 2u);
+  EXPECT_EQ(m.components[0].model, MODEL_GLTF_PBR);
+  EXPECT_FLOAT_EQ(m.components[0].weight, 0.4f);
+  EXPECT_FLOAT_EQ(m.components[0].params.v[GLTF_PBR_ROUGHNESS / 4][GLTF_PBR_ROUGHNESS % 4], 0.3f);
+  EXPECT_EQ(m.components[1].model, MODEL_DIELECTRIC);
+  EXPECT_FLOAT_EQ(m.components[1].weight, 0.6f);
+  EXPECT_FLOAT_EQ(m.components[1].params.v[DIELECTRIC_ETA / 4][DIELECTRIC_ETA % 4], 1.33f);
+  EXPECT_FALSE(hasWarning(s, "read but not rendered yet"));
+  j["materials"][0] = Json::parse(R"({"name": "glass", "pbrMetallicRoughness": {"metallicFactor": 0},
+    "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}}})");
+  const Material g = loadJson(j).materials[0];
+  EXPECT_FALSE(g.combined());
+  EXPECT_EQ(g.model, MODEL_DIELECTRIC);
+  EXPECT_FLOAT_EQ(g.params.v[DIELECTRIC_ETA / 4][DIELECTRIC_ETA % 4], 1.5f);
 }
 
 TEST(GltfTextures, ImageSourcesBufferViewDataUriAndExternalFile) {

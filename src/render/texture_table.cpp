@@ -1,0 +1,115 @@
+// texture_table.cpp: the scene's textures packed for the GPU (texture_table.h).
+#include "render/texture_table.h"
+
+#include <map>
+
+#include "util/error.h"
+
+namespace nusselt {
+
+using shared::GpuMaterialTextures;
+using shared::GpuTexture;
+
+MaterialTextureUse textureUse(const Material& m, const Scene& scene) {
+  MaterialTextureUse u;
+  const bool pbr = !m.combined() && m.model == MODEL_GLTF_PBR;
+  u.baseColor = pbr && m.baseColorTexture.present();
+  u.metallicRoughness = pbr && m.metallicRoughnessTexture.present();
+  u.emissive = m.emits() && m.emissiveTexture.present();
+  u.alpha = m.alphaMode != AlphaMode::Opaque;
+  u.normal = m.normalTexture.present() && !scene.tangents.empty() && scene.tangents.size() == scene.positions.size();
+  return u;
+}
+
+namespace {
+template <class F>
+bool anyUsedMaterial(const Scene& scene, F f) {
+  std::vector<bool> used(scene.materials.size(), false);
+  for (std::uint32_t m : scene.triangleMaterial)
+    if (m < used.size()) used[m] = true;
+  for (std::size_t i = 0; i < scene.materials.size(); ++i)
+    if (used[i] && f(textureUse(scene.materials[i], scene))) return true;
+  return false;
+}
+}  // namespace
+
+bool sceneUsesTextures(const Scene& scene) {
+  return anyUsedMaterial(scene, [](const MaterialTextureUse& u) { return u.any(); });
+}
+
+bool sceneUsesAlpha(const Scene& scene) {
+  return anyUsedMaterial(scene, [](const MaterialTextureUse& u) { return u.alpha; });
+}
+
+bool sceneUsesNormalMaps(const Scene& scene) {
+  return anyUsedMaterial(scene, [](const MaterialTextureUse& u) { return u.normal; });
+}
+
+std::vector<std::uint32_t> packTexels(const TextureImage& image) {
+  const std::size_t n = std::size_t(image.width) * image.height;
+  if (image.rgba.size() != 4 * n) throw Error("internal: image " + image.name + " has the wrong number of bytes");
+  std::vector<std::uint32_t> out(n);
+  for (std::size_t i = 0; i < n; ++i)
+    out[i] = std::uint32_t(image.rgba[4 * i]) | std::uint32_t(image.rgba[4 * i + 1]) << 8 |
+             std::uint32_t(image.rgba[4 * i + 2]) << 16 | std::uint32_t(image.rgba[4 * i + 3]) << 24;
+  return out;
+}
+
+GpuTexture packTexture(const TextureRef& ref, const TextureImage& image, std::uint32_t firstTexel) {
+  GpuTexture t{};
+  std::uint32_t flags = static_cast<std::uint32_t>(ref.wrapS) | static_cast<std::uint32_t>(ref.wrapT) << 2;
+  // No mipmaps: the magnification filter serves every footprint (docs/scenes.md).
+  if (ref.magFilter == FilterMode::Linear) flags |= TEXTURE_FLAG_LINEAR;
+  if (ref.colorSpace == ColorSpace::Srgb) flags |= TEXTURE_FLAG_SRGB;
+  if (ref.texCoord == 1) flags |= TEXTURE_FLAG_SET1;
+  t.info = glm::uvec4(firstTexel, image.width, image.height, flags);
+  t.transform0 = glm::vec4(ref.transform[0][0], ref.transform[0][1], ref.transform[1][0], ref.transform[1][1]);
+  t.transform1 = glm::vec4(ref.transform[2][0], ref.transform[2][1], 0.0f, 0.0f);
+  return t;
+}
+
+TextureData buildTextureData(const Scene& scene) {
+  TextureData d;
+  if (!sceneUsesTextures(scene)) return d;
+  std::vector<bool> used(scene.materials.size(), false);
+  for (std::uint32_t m : scene.triangleMaterial)
+    if (m < used.size()) used[m] = true;
+  std::map<std::int32_t, std::uint32_t> firstTexel;  // scene image -> its texels in the buffer
+  auto add = [&](const TextureRef& ref, const std::string& what) -> std::uint32_t {
+    if (ref.image < 0 || std::size_t(ref.image) >= scene.images.size())
+      throw Error("internal: " + what + " names image " + std::to_string(ref.image) + " of " +
+                  std::to_string(scene.images.size()));
+    const TextureImage& image = scene.images[std::size_t(ref.image)];
+    if (image.width == 0 || image.height == 0) throw Error("internal: image " + image.name + " is empty");
+    auto it = firstTexel.find(ref.image);
+    if (it == firstTexel.end()) {
+      std::vector<std::uint32_t> t = packTexels(image);
+      if (d.texels.size() + t.size() > UINT32_MAX) throw Error("the scene's textures exceed 2^32 texels");
+      it = firstTexel.emplace(ref.image, std::uint32_t(d.texels.size())).first;
+      d.texels.insert(d.texels.end(), t.begin(), t.end());
+    }
+    d.textures.push_back(packTexture(ref, image, it->second));
+    return std::uint32_t(d.textures.size() - 1);
+  };
+  d.materials.resize(scene.materials.size());
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    GpuMaterialTextures& g = d.materials[i];
+    g.maps = glm::uvec4(INVALID_INDEX);
+    g.baseColorFactor = m.baseColorFactor;
+    g.factors = glm::vec4(m.metallicFactor, m.roughnessFactor, m.normalScale, m.alphaCutoff);
+    g.alpha = glm::uvec4(static_cast<std::uint32_t>(m.alphaMode), INVALID_INDEX, 0u, 0u);
+    if (!used[i]) continue;
+    const MaterialTextureUse u = textureUse(m, scene);
+    if (u.baseColor) g.maps.x = add(m.baseColorTexture, m.name + " baseColorTexture");
+    if (u.metallicRoughness) g.maps.y = add(m.metallicRoughnessTexture, m.name + " metallicRoughnessTexture");
+    if (u.emissive) g.maps.z = add(m.emissiveTexture, m.name + " emissiveTexture");
+    if (u.normal) g.maps.w = add(m.normalTexture, m.name + " normalTexture");
+    // Coverage: the base-colour texture's alpha, for any model (its RGB applies to gltf_pbr only).
+    if (u.alpha && m.baseColorTexture.present())
+      g.alpha.y = u.baseColor ? g.maps.x : add(m.baseColorTexture, m.name + " baseColorTexture (alpha)");
+  }
+  return d;
+}
+
+}  // namespace nusselt

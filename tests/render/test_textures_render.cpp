@@ -1,0 +1,485 @@
+// Textures in renders (issue 18): an emissive texture seen by the camera reproduces its texels;
+// a textured emitter lights a floor alike under light sampling, BSDF sampling and MIS (the
+// texture is evaluated at the sampled point, the selection pdf does not depend on it); the
+// baseColor and metallicRoughness textures of gltf_pbr give, per checker cell, the directional
+// albedo of the parameters that cell's texels predict (a quad under a uniform white sky).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "../support/test_support.h"
+#include "brdf/registry.h"
+#include "../../shaders/shared/brdf/dispatch.h"
+#include "../../shaders/shared/texture.h"
+#include "../../shaders/shared/warp.h"
+
+using namespace nusselt;
+
+namespace {
+
+// sRGB code value -> linear (IEC 61966-2-1), in double.
+double srgb(int code) {
+  double c = code / 255.0;
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+// An image of w x h texels from a function (x, y) -> rgba codes.
+template <class F>
+int addImage(Scene& s, std::uint32_t w, std::uint32_t h, F texel) {
+  TextureImage im;
+  im.name = "image" + std::to_string(s.images.size());
+  im.width = w;
+  im.height = h;
+  for (std::uint32_t y = 0; y < h; ++y)
+    for (std::uint32_t x = 0; x < w; ++x) {
+      glm::ivec4 c = texel(int(x), int(y));
+      for (int k = 0; k < 4; ++k) im.rgba.push_back(std::uint8_t(c[k]));
+    }
+  s.images.push_back(im);
+  return int(s.images.size() - 1);
+}
+
+TextureRef nearest(int image, ColorSpace c) {
+  TextureRef r;
+  r.image = image;
+  r.magFilter = r.minFilter = FilterMode::Nearest;
+  r.colorSpace = c;
+  return r;
+}
+
+// The quad [-1, 1]^2 in the plane z = z0 facing +z (facing -z when down), texture coordinates
+// u = (x + 1) / 2, v = (1 - y) / 2: the image's top row at +y.
+void addTexturedQuad(Scene& s, float z0, std::uint32_t material, float half = 1.0f, bool down = false) {
+  glm::vec3 a(-half, -half, z0), b(half, -half, z0), c(half, half, z0), d(-half, half, z0);
+  if (down) std::swap(b, d);
+  test::addQuad(s, a, b, c, d, material);
+  for (glm::vec3 p : {a, b, c, a, c, d}) s.texcoords0.push_back(glm::vec2((p.x / half + 1) / 2, (1 - p.y / half) / 2));
+}
+
+void lookDown(Scene& s, float height, float mag) {
+  s.hasCamera = true;
+  s.camera.orthographic = true;
+  s.camera.position = glm::vec3(0, 0, height);
+  s.camera.forward = glm::vec3(0, 0, -1);
+  s.camera.up = glm::vec3(0, 1, 0);
+  s.camera.xmag = s.camera.ymag = mag;
+}
+
+Material gltfPbr(glm::vec3 base, float metallic, float roughness) {
+  Material m;
+  m.name = "pbr";
+  m.model = MODEL_GLTF_PBR;
+  m.params = packParams(*findModel("gltf_pbr"),
+                        {{"baseColor", arrayValue({ParamValue::num(base.x), ParamValue::num(base.y), ParamValue::num(base.z)})},
+                         {"metallic", ParamValue::num(metallic)},
+                         {"roughness", ParamValue::num(roughness)}},
+                        "test");
+  m.baseColorFactor = glm::vec4(base, 1.0f);
+  m.metallicFactor = metallic;
+  m.roughnessFactor = roughness;
+  return m;
+}
+
+const int kCodes[4][3] = {{255, 128, 0}, {64, 255, 32}, {10, 20, 200}, {128, 128, 128}};  // texel (x, y): [x + 2 y]
+
+}  // namespace
+
+// A 2 x 2 sRGB emissive texture on a quad filling a 16 x 16 orthographic view, max depth 0
+// (emitted light only): every pixel lies inside one texel's 8 x 8 pixel cell, so every sample of
+// it is emission x the decoded texel, exactly (no noise); checked to 1e-5 relative.
+TEST(TexturesRender, EmissiveTextureSeenByTheCameraReproducesTheTexels) {
+  Scene s;
+  Material m = gltfPbr(glm::vec3(0.5f), 0.0f, 1.0f);
+  m.emission = glm::vec3(2.0f, 1.0f, 0.5f);
+  int image = addImage(s, 2, 2, [](int x, int y) {
+    const int* c = kCodes[x + 2 * y];
+    return glm::ivec4(c[0], c[1], c[2], 255);
+  });
+  m.emissiveTexture = nearest(image, ColorSpace::Srgb);
+  s.materials.push_back(m);
+  addTexturedQuad(s, 0.0f, 0);
+  lookDown(s, 1.0f, 1.0f);
+  RenderSettings rs;
+  rs.width = rs.height = 16;
+  rs.spp = 4;
+  rs.maxDepth = 0;
+  rs.seed = 5;
+  test::Rendered r = test::render(s, rs);
+  int bad = 0;
+  for (int py = 0; py < 16; ++py)
+    for (int px = 0; px < 16; ++px) {
+      const int* c = kCodes[px / 8 + 2 * (py / 8)];
+      for (int k = 0; k < 3; ++k) {
+        double expected = m.emission[k] * srgb(c[k]);
+        double got = r.image.rgb[3 * (py * 16 + px) + k];
+        if (!(std::fabs(got - expected) <= 1e-5 * expected + 1e-7) && ++bad <= 5)
+          ADD_FAILURE() << "pixel (" << px << ", " << py << ") channel " << k << ": " << got << ", expected " << expected;
+      }
+    }
+  EXPECT_EQ(bad, 0);
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// A floor lit by a small textured emitter (left half of the texture bright and warm, right half
+// dim and blue, linear filtering) above it: light sampling, BSDF sampling and MIS are three
+// unbiased estimators of the same image only if the emitter's texture is read at the sampled
+// point (NEE) as at the point a BSDF ray hits (the selection pdf ignores the texture). Welch
+// z-tests per 4 x 4 block, as test_mis.cpp (cell alpha 0.01, binomial bound at 0.001). The
+// images must also show the texture: the floor under the bright half is brighter than under the
+// dim half by many standard errors.
+TEST(TexturesRender, TexturedEmitterNeeBsdfAndMisAgree) {
+  Scene s;
+  Material floor;
+  floor.name = "floor";
+  floor.model = findModel("lambert")->id;
+  floor.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(0.7)}}, "floor");
+  s.materials.push_back(floor);
+  Material lamp;
+  lamp.name = "lamp";
+  lamp.model = findModel("lambert")->id;
+  lamp.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(0.0)}}, "lamp");
+  lamp.emission = glm::vec3(6.0f);
+  TextureRef t;
+  t.image = addImage(s, 4, 1, [](int x, int) {
+    return x < 2 ? glm::ivec4(255, 200, 120, 255) : glm::ivec4(20, 30, 90, 255);
+  });
+  t.colorSpace = ColorSpace::Srgb;
+  t.wrapS = t.wrapT = WrapMode::ClampToEdge;
+  lamp.emissiveTexture = t;
+  s.materials.push_back(lamp);
+  addTexturedQuad(s, 0.0f, 0);
+  addTexturedQuad(s, 0.5f, 1, 0.4f, true);  // facing down onto the floor
+  // Looking down past the lamp's side: perspective, from above one corner.
+  s.hasCamera = true;
+  s.camera.position = glm::vec3(0.0f, -2.2f, 1.6f);
+  s.camera.forward = glm::normalize(glm::vec3(0.0f, 2.2f, -1.6f));
+  s.camera.up = glm::normalize(glm::cross(glm::cross(s.camera.forward, glm::vec3(0, 0, 1)), s.camera.forward));
+  s.camera.yfov = 0.9f;
+  RenderSettings rs;
+  rs.width = rs.height = 32;
+  rs.maxDepth = 1;
+  rs.spp = 64;
+  rs.seed = 21;
+  rs.lighting = LightingMode::Mis;
+  test::Rendered mis = test::render(s, rs);
+  rs.seed = 22;
+  rs.lighting = LightingMode::NeeOnly;
+  test::Rendered nee = test::render(s, rs);
+  rs.seed = 23;
+  rs.spp = 256;
+  rs.lighting = LightingMode::BsdfOnly;
+  test::Rendered bsdf = test::render(s, rs);
+  std::string m1 = test::compareImagesStatistically(nee.image, mis.image, 0.01, 0.001, 4);
+  EXPECT_TRUE(m1.empty()) << "NEE vs MIS: " << m1;
+  std::string m2 = test::compareImagesStatistically(bsdf.image, mis.image, 0.01, 0.001, 4);
+  EXPECT_TRUE(m2.empty()) << "BSDF vs MIS: " << m2;
+  // The texture shows: red channel of the floor's left third against its right third (the lamp
+  // spans the middle columns), z of the difference of the two means.
+  double sum[2] = {0, 0}, var[2] = {0, 0};
+  int count[2] = {0, 0};
+  for (int py = 20; py < 32; ++py)
+    for (int px = 0; px < 32; ++px) {
+      int side = px < 10 ? 0 : px >= 22 ? 1 : -1;
+      if (side < 0) continue;
+      sum[side] += mis.image.rgb[3 * (py * 32 + px)];
+      var[side] += mis.image.variance[3 * (py * 32 + px)];
+      ++count[side];
+    }
+  double left = sum[0] / count[0], right = sum[1] / count[1];
+  double se = std::sqrt(var[0] / (double(count[0]) * count[0]) + var[1] / (double(count[1]) * count[1]));
+  EXPECT_GT((left - right) / se, 10.0) << "left " << left << " right " << right << " se " << se;
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// gltf_pbr with a 2 x 2 baseColor texture (sRGB) and a 2 x 2 metallicRoughness texture (linear:
+// G roughness, B metallic), both NEAREST, times the factors, on a quad under a uniform white sky
+// (radiance 1), seen straight down, max depth 1: each 8 x 8 pixel cell converges to the
+// directional albedo at normal incidence of its texels' parameters, integral of f cos over the
+// hemisphere, computed here from the same BRDF (shared C++ build) by a stratified 1024 x 1024
+// cosine-weighted quadrature. z-test per cell and channel with the cell's variance of the mean
+// (from the per-pixel variances), significance 0.001 with Sidak over 12 tests. The predicted
+// albedos of the cells differ by more than 20 standard errors, so an ignored texture fails.
+TEST(TexturesRender, BaseColorAndMetallicRoughnessTexturesGiveThePredictedAlbedo) {
+  Scene s;
+  const glm::vec3 baseFactor(0.9f, 0.8f, 1.0f);
+  const float metallicFactor = 0.8f, roughnessFactor = 0.9f;
+  Material m = gltfPbr(baseFactor, metallicFactor, roughnessFactor);
+  int bc = addImage(s, 2, 2, [](int x, int y) {
+    const int* c = kCodes[x + 2 * y];
+    return glm::ivec4(c[0], c[1], c[2], 255);
+  });
+  // (G roughness, B metallic) per texel: rough dielectric, smoother half-metal, metal, mid.
+  const int mr[4][2] = {{255, 0}, {100, 128}, {160, 255}, {200, 64}};
+  int mrImage = addImage(s, 2, 2, [&](int x, int y) { return glm::ivec4(0, mr[x + 2 * y][0], mr[x + 2 * y][1], 255); });
+  m.baseColorTexture = nearest(bc, ColorSpace::Srgb);
+  m.metallicRoughnessTexture = nearest(mrImage, ColorSpace::Linear);
+  s.materials.push_back(m);
+  addTexturedQuad(s, 0.0f, 0);
+  lookDown(s, 1.0f, 1.0f);
+  s.background = glm::vec3(1.0f);
+  RenderSettings rs;
+  rs.width = rs.height = 16;
+  rs.spp = 256;
+  rs.maxDepth = 1;
+  rs.seed = 7;
+  test::Rendered r = test::render(s, rs);
+
+  const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 12.0)));
+  double predicted[4][3];
+  for (int cell = 0; cell < 4; ++cell) {
+    glm::vec3 base(float(baseFactor.x * srgb(kCodes[cell][0])), float(baseFactor.y * srgb(kCodes[cell][1])),
+                   float(baseFactor.z * srgb(kCodes[cell][2])));
+    float rough = roughnessFactor * float(mr[cell][0]) / 255.0f;
+    float metal = metallicFactor * float(mr[cell][1]) / 255.0f;
+    Material p = gltfPbr(base, metal, rough);
+    const int n = 1024;
+    double a[3] = {0, 0, 0};
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        glm::vec3 wi = shared::squareToCosineHemisphere(glm::vec2((i + 0.5f) / n, (j + 0.5f) / n));
+        glm::vec3 f = shared::brdfEval(MODEL_GLTF_PBR, p.params, wi, glm::vec3(0, 0, 1));
+        for (int k = 0; k < 3; ++k) a[k] += f[k] * M_PI;  // f cos / pdf, pdf = cos / pi
+      }
+    for (int k = 0; k < 3; ++k) predicted[cell][k] = a[k] / (double(n) * n);
+  }
+  double seOf[4][3];
+  for (int cell = 0; cell < 4; ++cell) {
+    int cx = cell % 2, cy = cell / 2;
+    for (int k = 0; k < 3; ++k) {
+      double sum = 0, var = 0;
+      for (int py = 8 * cy; py < 8 * cy + 8; ++py)
+        for (int px = 8 * cx; px < 8 * cx + 8; ++px) {
+          sum += r.image.rgb[3 * (py * 16 + px) + k];
+          var += r.image.variance[3 * (py * 16 + px) + k];
+        }
+      double mean = sum / 64, se = std::sqrt(var) / 64;
+      seOf[cell][k] = se;
+      double z = (mean - predicted[cell][k]) / se;
+      EXPECT_LT(std::fabs(z), zMax) << "cell " << cell << " channel " << k << ": " << mean << " vs predicted "
+                                    << predicted[cell][k] << " (se " << se << ")";
+    }
+  }
+  // Every pair of cells is told apart in some channel.
+  double minSeparation = 1e30;
+  for (int c1 = 0; c1 < 4; ++c1)
+    for (int c2 = c1 + 1; c2 < 4; ++c2) {
+      double best = 0;
+      for (int k = 0; k < 3; ++k)
+        best = std::max(best, std::fabs(predicted[c1][k] - predicted[c2][k]) /
+                                  std::sqrt(seOf[c1][k] * seOf[c1][k] + seOf[c2][k] * seOf[c2][k]));
+      minSeparation = std::min(minSeparation, best);
+    }
+  EXPECT_GT(minSeparation, 20.0) << "the cells' predicted albedos are too close to tell textures apart";
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// Normal maps: two flat quads (Lambert, rho 0.5) side by side, each with a constant 1 x 1 normal
+// map, under a directional light of irradiance E: every pixel is rho / pi x E x max(0, n.l) for
+// the normal n its texel encodes in the frame of scene.h (n = x t + y b + z N, b = w cross(N, t)),
+// i.e. the flat quad shades as the tilted plane. Left: tilted 30 degrees towards the tangent
+// (+x), w = +1. Right: tilted towards the bitangent with w = -1 (b = -y) and normalScale 0.5.
+// Direct light only (max depth 1): no noise, checked to 1e-4 relative.
+TEST(TexturesRender, ConstantNormalMapShadesAsTheTiltedPlane) {
+  Scene s;
+  const float a = 0.5235988f;  // 30 degrees
+  const glm::vec3 ts[2] = {{std::sin(a), 0.0f, std::cos(a)}, {0.0f, std::sin(a), std::cos(a)}};
+  const float scale[2] = {1.0f, 0.5f};
+  const float w[2] = {1.0f, -1.0f};
+  glm::vec3 expectedNormal[2];
+  for (int q = 0; q < 2; ++q) {
+    glm::ivec3 code;
+    for (int k = 0; k < 3; ++k) code[k] = int(std::lround((ts[q][k] + 1.0f) * 0.5f * 255.0f));
+    int image = addImage(s, 1, 1, [&](int, int) { return glm::ivec4(code, 255); });
+    Material m;
+    m.name = q == 0 ? "tangent" : "bitangent";
+    m.model = findModel("lambert")->id;
+    m.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(0.5)}}, m.name);
+    m.normalTexture = nearest(image, ColorSpace::Linear);
+    m.normalScale = scale[q];
+    s.materials.push_back(m);
+    const float x0 = q == 0 ? -1.0f : 0.0f;
+    glm::vec3 A(x0, -1, 0), B(x0 + 1, -1, 0), C(x0 + 1, 1, 0), D(x0, 1, 0);
+    test::addQuad(s, A, B, C, D, std::uint32_t(q));
+    for (glm::vec3 p : {A, B, C, A, C, D}) {
+      s.texcoords0.push_back(glm::vec2(p.x - x0, (1 - p.y) / 2));
+      s.tangents.push_back(glm::vec4(1, 0, 0, w[q]));
+    }
+    // The shader's arithmetic on the decoded texel: [0, 1] -> [-1, 1], xy x scale, in the frame.
+    glm::vec3 c = glm::vec3(code) / 255.0f * 2.0f - 1.0f;
+    glm::vec3 t(1, 0, 0), N(0, 0, 1), b = w[q] * glm::cross(N, t);
+    expectedNormal[q] = glm::normalize(c.x * scale[q] * t + c.y * scale[q] * b + c.z * N);
+  }
+  const glm::vec3 l = glm::normalize(glm::vec3(0.5f, -0.6f, 1.0f));  // towards the light
+  PunctualLight sun;
+  sun.type = LightType::Directional;
+  sun.direction = -l;
+  sun.intensity = glm::vec3(2.0f);
+  s.lights.push_back(sun);
+  lookDown(s, 1.0f, 1.0f);
+  RenderSettings rs;
+  rs.width = rs.height = 16;
+  rs.spp = 4;
+  rs.maxDepth = 1;
+  rs.seed = 3;
+  test::Rendered r = test::render(s, rs);
+  int bad = 0;
+  double value[2];
+  for (int q = 0; q < 2; ++q) value[q] = 0.5 / M_PI * 2.0 * std::max(0.0f, glm::dot(expectedNormal[q], l));
+  const double flat = 0.5 / M_PI * 2.0 * l.z;
+  EXPECT_GT(std::fabs(value[0] - flat), 0.05 * flat);  // the maps change the image
+  EXPECT_GT(std::fabs(value[1] - flat), 0.05 * flat);
+  for (int py = 0; py < 16; ++py)
+    for (int px = 0; px < 16; ++px) {
+      double expected = value[px < 8 ? 0 : 1];
+      for (int k = 0; k < 3; ++k) {
+        double got = r.image.rgb[3 * (py * 16 + px) + k];
+        if (!(std::fabs(got - expected) <= 1e-4 * expected) && ++bad <= 5)
+          ADD_FAILURE() << "pixel (" << px << ", " << py << ") channel " << k << ": " << got << ", expected " << expected
+                        << " (flat " << flat << ")";
+      }
+    }
+  EXPECT_EQ(bad, 0);
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+namespace {
+
+Material lambert(const std::string& name, double rho) {
+  Material m;
+  m.name = name;
+  m.model = findModel("lambert")->id;
+  m.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(rho)}}, name);
+  return m;
+}
+
+// The traversals this device has: the GLSL BVH, and ray queries when offered.
+std::vector<Traversal> traversals() {
+  std::vector<Traversal> t{Traversal::Bvh};
+  if (test::context().rayQuery) t.push_back(Traversal::RayQuery);
+  return t;
+}
+
+}  // namespace
+
+// alphaMode MASK: a black quad whose base-colour texture's alpha is (1, 0 / 0.39, 0.78) per
+// texel, cutoff 0.5, in front of an emitter of radiance 1, seen straight down with max depth 0:
+// each 8 x 8 pixel cell is exactly 0 where alpha >= cutoff (the quad) and 1 where it is cut out
+// (the emitter behind), under both traversals. The texture's RGB does not apply (lambert).
+TEST(TexturesRender, MaskCutsOutWhereAlphaIsBelowTheCutoff) {
+  Scene s;
+  Material lamp = lambert("lamp", 0.0);
+  lamp.emission = glm::vec3(1.0f);
+  s.materials.push_back(lamp);
+  Material mask = lambert("mask", 0.0);
+  mask.alphaMode = AlphaMode::Mask;
+  mask.alphaCutoff = 0.5f;
+  const int alphaCode[4] = {255, 0, 100, 200};
+  mask.baseColorTexture = nearest(addImage(s, 2, 2, [&](int x, int y) {
+    return glm::ivec4(255, 0, 0, alphaCode[x + 2 * y]);
+  }), ColorSpace::Srgb);
+  s.materials.push_back(mask);
+  addTexturedQuad(s, 0.0f, 0);
+  addTexturedQuad(s, 0.5f, 1);
+  lookDown(s, 1.0f, 1.0f);
+  for (Traversal tr : traversals()) {
+    RenderSettings rs;
+    rs.width = rs.height = 16;
+    rs.spp = 4;
+    rs.maxDepth = 0;
+    rs.seed = 9;
+    rs.traversal = tr;
+    test::Rendered r = test::render(s, rs);
+    int bad = 0;
+    for (int py = 0; py < 16; ++py)
+      for (int px = 0; px < 16; ++px) {
+        const bool opaque = alphaCode[px / 8 + 2 * (py / 8)] / 255.0f >= 0.5f;
+        const float expected = opaque ? 0.0f : 1.0f;
+        for (int k = 0; k < 3; ++k)
+          if (std::fabs(r.image.rgb[3 * (py * 16 + px) + k] - expected) > 1e-6f && ++bad <= 5)
+            ADD_FAILURE() << (tr == Traversal::Bvh ? "bvh" : "rayquery") << " pixel (" << px << ", " << py
+                          << "): " << r.image.rgb[3 * (py * 16 + px) + k] << ", expected " << expected;
+      }
+    EXPECT_EQ(bad, 0);
+  }
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// alphaMode BLEND, stochastic: a black quad of alpha 0.5 (baseColorFactor) between an
+// orthographic camera and a Lambert floor (rho 0.8) lit by a directional light. A camera ray
+// passes the quad with probability 1/2, and so does the floor's shadow ray: the image converges
+// to 1/4 of the unoccluded floor, rho / pi E cos. z-test of the image mean per channel with the
+// per-pixel variances, significance 0.001 with Sidak over 3 channels x 2 traversals.
+TEST(TexturesRender, HalfTransparentBlendPassesHalfOfCameraAndShadowRays) {
+  Scene s;
+  s.materials.push_back(lambert("floor", 0.8));
+  Material veil = lambert("veil", 0.0);
+  veil.alphaMode = AlphaMode::Blend;
+  veil.baseColorFactor = glm::vec4(1.0f, 1.0f, 1.0f, 0.5f);
+  s.materials.push_back(veil);
+  addTexturedQuad(s, 0.0f, 0);
+  addTexturedQuad(s, 0.5f, 1);
+  const glm::vec3 l = glm::normalize(glm::vec3(0.3f, 0.2f, 1.0f));
+  PunctualLight sun;
+  sun.type = LightType::Directional;
+  sun.direction = -l;
+  sun.intensity = glm::vec3(2.0f);
+  s.lights.push_back(sun);
+  lookDown(s, 1.0f, 0.9f);
+  const double open = 0.8 / M_PI * 2.0 * l.z;
+  const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 6.0)));
+  for (Traversal tr : traversals()) {
+    RenderSettings rs;
+    rs.width = rs.height = 16;
+    rs.spp = 64;
+    rs.maxDepth = 1;
+    rs.seed = 13;
+    rs.traversal = tr;
+    test::Rendered r = test::render(s, rs);
+    for (int k = 0; k < 3; ++k) {
+      double sum = 0, var = 0;
+      for (int p = 0; p < 256; ++p) {
+        sum += r.image.rgb[3 * p + k];
+        var += r.image.variance[3 * p + k];
+      }
+      double mean = sum / 256, se = std::sqrt(var) / 256;
+      EXPECT_LT(std::fabs(mean - 0.25 * open) / se, zMax)
+          << (tr == Traversal::Bvh ? "bvh" : "rayquery") << " channel " << k << ": mean " << mean << ", expected "
+          << 0.25 * open << " (se " << se << ")";
+      // Neither opaque (0) nor absent (open) nor transparent to one kind of ray only (open / 2).
+      EXPECT_GT(std::fabs(mean - 0.5 * open) / se, 10.0);
+    }
+  }
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// KHR_materials_transmission (issue 18, part 5): scenes/tests/glass_slab.gltf, a glass slab
+// (transmission 1, ior 1.5) over an emitter of radiance 1, seen straight down through it
+// (orthographic): the image converges to the slab's transmittance (1 - R) / (1 + R), R = 0.04
+// (two interfaces and every internal reflection; max depth 32 leaves R^30 out). z-test of the
+// image mean per channel, significance 0.001 with Sidak over 3.
+TEST(TexturesRender, GlassSlabTransmitsAsFresnelPredicts) {
+  Scene s = test::loadTestScene("scenes/tests/glass_slab.gltf");
+  lookDown(s, 1.0f, 0.9f);
+  RenderSettings rs;
+  rs.width = rs.height = 16;
+  rs.spp = 64;
+  rs.maxDepth = 32;
+  rs.seed = 17;
+  test::Rendered r = test::render(s, rs);
+  const double R = 0.04, expected = (1 - R) / (1 + R);
+  const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 3.0)));
+  for (int k = 0; k < 3; ++k) {
+    double sum = 0, var = 0;
+    for (int p = 0; p < 256; ++p) {
+      sum += r.image.rgb[3 * p + k];
+      var += r.image.variance[3 * p + k];
+    }
+    double mean = sum / 256, se = std::sqrt(var) / 256;
+    EXPECT_LT(std::fabs(mean - expected) / se, zMax) << "channel " << k << ": " << mean << " vs " << expected
+                                                     << " (se " << se << ")";
+    EXPECT_GT(std::fabs(mean - 1.0) / se, 5.0);  // the slab is seen (not fully transparent)
+  }
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
