@@ -1,6 +1,6 @@
 // test_texture_gpu.cpp: CPU/GPU parity of the shared texture lookup (shaders/shared/texture.h):
 // the same texels, texture records and coordinates through the C++ build and through the GLSL
-// build on the device (shaders/stages/texture_tool.comp), for every pair of wrap modes, both
+// build on the device (shaders/tools/texture_tool.comp), for every pair of wrap modes, both
 // filters, linear and sRGB data, and a texture transform.
 #include <gtest/gtest.h>
 
