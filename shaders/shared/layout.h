@@ -7,6 +7,7 @@
 #include "prelude.h"
 #include "quadtree_layout.h"
 #include "tabulated_layout.h"
+#include "guiding_layout.h"
 
 SHARED_BEGIN
 
@@ -295,12 +296,13 @@ struct Globals {
   BUFREF(Floats) tabData;      // the CDFs of every table
   BUFREF(Floats) measured;     // measured BRDF tables (merl: MERL_TABLE_FLOATS each, brdf/merl.h)
   BUFREF(Environments) environment; // one GpuEnvironment (0 when the scene has none)
+  BUFREF(GpuGuides) guide;     // one GpuGuide (guiding_layout.h; 0 unless the render is guided)
   // The top-level acceleration structure's device address, low and high 32 bits, for ray queries
   // (shaders/shared/trace.glsl with NUSSELT_RAY_QUERY); 0 when the GLSL BVH traces.
   uint tlasLow;
   uint tlasHigh;
 };
-STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 31 * 8 + 8);
+STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 32 * 8 + 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 
