@@ -14,6 +14,7 @@
 #include "shared/warp.h"
 #include "shared/trace.glsl"
 #include "shared/envmap.h"
+#include "shared/guiding.h"
 
 layout(local_size_x = WORKGROUP_SIZE) in;
 
@@ -21,6 +22,9 @@ layout(local_size_x = WORKGROUP_SIZE) in;
 // render builds only what its scene needs (lavapipe's Mesa 22.3 ran every branch body a subgroup
 // reached, taken or not; reference/lavapipe.md). Constant 7: after the shade stages' own 0..6.
 layout(constant_id = 7) const bool HAS_ENVIRONMENT = true;
+// Path guiding (issue 16, docs/guiding.md): the shade and escape stages of a guided render only;
+// without it every guiding branch is compiled out, and images are those of an unguided build.
+layout(constant_id = 8) const bool GUIDING = false;
 
 // ---- Queues ---------------------------------------------------------------------------------
 
