@@ -9,7 +9,8 @@
 #
 #   tools/bench_guiding.sh [DIR] [NUSSELT]
 # Environment: SIZE (default 128), SPP (64), REF_SPP (4096), REPEATS (3), DEPTH (8),
-#   SCENES (default: scenes/cornell/cornell-indirect.glb and the default Cornell box, "default").
+#   SCENES (default: scenes/cornell/cornell-indirect.glb and the default Cornell box, "default"),
+#   GUIDE_ARGS (extra options of the guided renders, e.g. "--guide-spatial 1000").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=${1:-/tmp/nusselt-bench-guiding}
@@ -26,7 +27,7 @@ common="--width $size --height $size --max-depth $depth -q --checkpoint 0"
 
 median() { sort -g | awk '{v[NR] = $1} END {if (NR % 2) print v[(NR + 1) / 2]; else print (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
 
-echo "bench_guiding: ${size}x${size}, $spp spp per run, reference $refSpp spp (unguided), max depth $depth, $repeats repeats"
+echo "bench_guiding: ${size}x${size}, $spp spp per run, reference $refSpp spp (unguided), max depth $depth, $repeats repeats, guided with: --guiding on ${GUIDE_ARGS:-}"
 echo "device: $("$bin" devices | head -1)"
 for scene in $scenes; do
   name=$(basename "$scene" .glb)
@@ -45,7 +46,9 @@ for scene in $scenes; do
       out="$dir/$name-$mode-$r.exr"
       t0=$(date +%s.%N)
       # shellcheck disable=SC2086
-      "$bin" render $sceneArg $common --spp "$spp" --seed "$r" --guiding "$mode" -o "$out"
+      extra=""
+      [ "$mode" = on ] && extra=${GUIDE_ARGS:-}
+      "$bin" render $sceneArg $common --spp "$spp" --seed "$r" --guiding "$mode" $extra -o "$out"
       t1=$(date +%s.%N)
       sec=$(echo "$t1 - $t0" | bc -l)
       rel=$("$bin" diff "$out" "$ref" | awk '{print $2}')

@@ -54,6 +54,7 @@ struct RenderArgs {
   std::string guiding = "off";
   std::uint32_t guideTrain = 0;
   double guideMemoryMiB = 16;
+  double guideSpatial = 12000;
   bool variance = false;
   bool validation = false;
   bool quiet = false;
@@ -91,6 +92,7 @@ int renderCommand(const RenderArgs& a) {
   parseTraversal(a.traversal, s.traversal);
   s.guiding = a.guiding == "on";
   s.guideTrainSpp = a.guideTrain;
+  s.guideSpatialThreshold = a.guideSpatial;
   s.guideMemory = static_cast<std::uint64_t>(a.guideMemoryMiB * 1048576.0);
   if (s.guiding && !a.resume.empty())
     throw Error("--resume with --guiding on: a guided render cannot be resumed yet (its guide is not in the file; "
@@ -676,6 +678,10 @@ int runCli(int argc, char** argv) {
       ->capture_default_str()->check(CLI::Range(0u, 1u << 30));
   render->add_option("--guide-memory", ra.guideMemoryMiB, "Memory cap of the guide's trees on the device, MiB")
       ->capture_default_str()->check(CLI::Range(0.01, 4096.0));
+  render->add_option("--guide-spatial", ra.guideSpatial, "The guide's spatial split rule: a region splits after c "
+                                                         "sqrt(2^k) training splats in iteration k (Mueller et al.: "
+                                                         "12000, for 1280 x 720 images)")
+      ->capture_default_str()->check(CLI::Range(1.0, 1e12));
   render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
   render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
   render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");

@@ -136,6 +136,7 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
     guiding::GuideSettings gs;
     gs.memoryCap = settings.guideMemory;
     gs.alpha = settings.guideAlpha;
+    gs.spatialThreshold = settings.guideSpatialThreshold;
     m_guide = std::make_unique<DeviceGuide>(m_ctx, lo, hi, gs,
                                             PathIntegrator::capacityFor(settings, pixels, m_samplesPerPass),
                                             settings.maxDepth);

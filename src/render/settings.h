@@ -149,6 +149,10 @@ struct RenderSettings {
   // The guide's selection probability in regions that learned something (`--guide-alpha`): 0
   // keeps the guided pipelines but never samples the guide (to measure their cost).
   float guideAlpha = 0.5f;
+  // c of the guide's spatial split rule (`--guide-spatial`): a region splits after c sqrt(2^k)
+  // splats in iteration k. Mueller et al.'s 12000 suits their 1280 x 720 images; small images
+  // get few regions with it (docs/guiding.md, measurements).
+  double guideSpatialThreshold = 12000;
 };
 
 // The training samples per pixel of a guided render: settings.guideTrainSpp, or when 0 the

@@ -100,3 +100,4 @@ TEST(Guiding, SameSeedIsBitIdentical) {
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
+
