@@ -9,7 +9,8 @@
 #
 #   tools/bench_guiding.sh [DIR] [NUSSELT]
 # Environment: SIZE (default 128), SPP (64), REF_SPP (4096), REPEATS (3), DEPTH (8),
-#   SCENES (default: scenes/cornell/cornell-indirect.glb and the default Cornell box, "default"),
+#   SCENES (default: scenes/cornell/cornell-indirect.glb, scenes/tests/guiding_gap.gltf and the
+#   default Cornell box, "default"),
 #   GUIDE_ARGS (extra options of the guided renders, e.g. "--guide-spatial 1000").
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,7 +22,7 @@ spp=${SPP:-64}
 refSpp=${REF_SPP:-4096}
 repeats=${REPEATS:-3}
 depth=${DEPTH:-8}
-scenes=${SCENES:-"scenes/cornell/cornell-indirect.glb default"}
+scenes=${SCENES:-"scenes/cornell/cornell-indirect.glb scenes/tests/guiding_gap.gltf default"}
 mkdir -p "$dir"
 common="--width $size --height $size --max-depth $depth -q --checkpoint 0"
 
@@ -30,7 +31,7 @@ median() { sort -g | awk '{v[NR] = $1} END {if (NR % 2) print v[(NR + 1) / 2]; e
 echo "bench_guiding: ${size}x${size}, $spp spp per run, reference $refSpp spp (unguided), max depth $depth, $repeats repeats, guided with: --guiding on ${GUIDE_ARGS:-}"
 echo "device: $("$bin" devices | head -1)"
 for scene in $scenes; do
-  name=$(basename "$scene" .glb)
+  name=$(basename "${scene%.gltf}" .glb)
   sceneArg=$scene
   [ "$scene" = default ] && sceneArg=""
   ref="$dir/$name-ref-$size-$refSpp-$depth.exr"
