@@ -26,6 +26,10 @@
                  emitter of radiance 1 at z = 0 facing +z; camera above, looking down. Seen
                  through the slab at normal incidence the emitter converges to (1 - R) / (1 + R)
                  with R = 0.04 (both faces and every internal reflection).
+  guiding_gap.gltf  two rooms (4 x 2 x 2, Lambert rho 0.7) divided by a wall at x = 0 with a
+                 0.3 x 0.3 opening at its centre; the area light is on the ceiling of the left room,
+                 the camera in the right one: the right room sees light only through the opening
+                 (path guiding's benchmark, docs/guiding.md).
 
 Emissive surfaces are one-sided: they emit on the side of their geometric normal
 (v1 - v0) x (v2 - v0), so every triangle here is wound to face where it should emit or be seen.
@@ -426,6 +430,26 @@ def glass_slab():
     b.write("glass_slab.gltf")
 
 
+def guiding_gap():
+    b = Builder()
+    white = b.material("white", 0.7)
+    light = b.material("light", 0.0, emission=(1.0, 1.0, 1.0), strength=30.0)
+    b.quad("floor", [[-2, 0, -1], [-2, 0, 1], [2, 0, 1], [2, 0, -1]], white)
+    b.quad("ceiling", [[-2, 2, -1], [2, 2, -1], [2, 2, 1], [-2, 2, 1]], white)
+    b.quad("back", [[-2, 0, -1], [2, 0, -1], [2, 2, -1], [-2, 2, -1]], white)
+    b.quad("front", [[-2, 0, 1], [-2, 2, 1], [2, 2, 1], [2, 0, 1]], white)
+    b.quad("left", [[-2, 0, 1], [-2, 0, -1], [-2, 2, -1], [-2, 2, 1]], white)
+    b.quad("right", [[2, 0, -1], [2, 0, 1], [2, 2, 1], [2, 2, -1]], white)
+    # The dividing wall at x = 0 around its opening y in [0.85, 1.15], z in [-0.15, 0.15].
+    b.quad("wall_below", [[0, 0, -1], [0, 0, 1], [0, 0.85, 1], [0, 0.85, -1]], white)
+    b.quad("wall_above", [[0, 1.15, -1], [0, 1.15, 1], [0, 2, 1], [0, 2, -1]], white)
+    b.quad("wall_back", [[0, 0.85, -1], [0, 0.85, -0.15], [0, 1.15, -0.15], [0, 1.15, -1]], white)
+    b.quad("wall_front", [[0, 0.85, 0.15], [0, 0.85, 1], [0, 1.15, 1], [0, 1.15, 0.15]], white)
+    b.quad("light", [[-1.5, 1.99, -0.4], [-0.5, 1.99, -0.4], [-0.5, 1.99, 0.4], [-1.5, 1.99, 0.4]], light)
+    b.camera("camera", (1.95, 1.2, 0.9), (0.0, 0.7, -0.3), 1.2, 1.0)
+    b.write("guiding_gap.gltf")
+
+
 if __name__ == "__main__":
     furnace()
     mis()
@@ -436,3 +460,4 @@ if __name__ == "__main__":
     env_bench(True)
     textures()
     glass_slab()
+    guiding_gap()

@@ -8,6 +8,7 @@
 #include "quadtree_layout.h"
 #include "tabulated_layout.h"
 #include "texture_layout.h"
+#include "guiding_layout.h"
 
 SHARED_BEGIN
 
@@ -308,12 +309,13 @@ struct Globals {
   BUFREF(TriTexcoords) texcoords; // per triangle, parallel to `triangles`
   BUFREF(Vec4s) tangents;      // per triangle 3 vec4, the corners' tangents (Scene::tangents: xyz, w = bitangent
                                // sign), parallel to `triangles`; one entry when no material is normal-mapped
+  BUFREF(GpuGuides) guide;     // one GpuGuide (guiding_layout.h; 0 unless the render is guided)
   // The top-level acceleration structure's device address, low and high 32 bits, for ray queries
   // (shaders/shared/trace.glsl with NUSSELT_RAY_QUERY); 0 when the GLSL BVH traces.
   uint tlasLow;
   uint tlasHigh;
 };
-STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 36 * 8 + 8);
+STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 37 * 8 + 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 

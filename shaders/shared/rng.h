@@ -17,6 +17,8 @@ SHARED_BEGIN
 #define RNG_DIM_BSDF 3u          // and 4
 #define RNG_DIM_ROULETTE 5u
 #define RNG_DIM_COMPONENT 6u
+#define RNG_DIM_GUIDE 7u         // and 8: path guiding's choice of the guide, its tree descent
+#define RNG_DIM_GUIDE_CELL 9u    // and 10: the point in the guide's chosen cell
 // Rejection loops (the quadtree sampler) draw from their own stream: dimension | this bit.
 #define RNG_REJECTION_STREAM 0x80000000u
 

@@ -56,6 +56,7 @@ bool alphaPasses(uint tri, float b1, float b2, vec3 origin, vec3 dir) {
 
 #include "shared/trace.glsl"
 #include "shared/envmap.h"
+#include "shared/guiding.h"
 
 layout(local_size_x = WORKGROUP_SIZE) in;
 
@@ -65,6 +66,9 @@ layout(local_size_x = WORKGROUP_SIZE) in;
 layout(constant_id = 7) const bool HAS_ENVIRONMENT = true;
 // Likewise the texture lookups of a scene without textures (Globals.texturedScene; constant 8).
 layout(constant_id = 8) const bool HAS_TEXTURES = true;
+// Path guiding (issue 16, docs/guiding.md): the shade and escape stages of a guided render only;
+// without it every guiding branch is compiled out, and images are those of an unguided build.
+layout(constant_id = 10) const bool GUIDING = false;
 
 // ---- Queues ---------------------------------------------------------------------------------
 

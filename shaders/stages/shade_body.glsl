@@ -127,6 +127,7 @@ void main() {
   vec3 beta = throughput.xyz;
   float etaScale = throughput.w;
   vec3 L = vec3(0.0f);
+  if (GUIDING) guideRecordArrival(path, bounce, x);  // training record (guiding.h)
 
   // ---- Emission: one-sided emitters radiate along their geometric normal ----
   bool frontFace = dot(ngFront, dir) < 0.0f;
@@ -162,6 +163,9 @@ void main() {
 #if !SHADE_COMBINED
   {
     // ---- A single-model material ----
+    // The guide's region (path guiding, guiding.h): never for delta models.
+    GuideVertex gv = GuideVertex(0u, 0.0f);
+    if (GUIDING && !modelIsDelta(MODEL_ID)) gv = guideVertex(x);
     // ---- Next-event estimation ----
     if (!last && lighting != LIGHTING_BSDF_ONLY && !modelIsDelta(MODEL_ID)) {
       float uSel = sample1(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_LIGHT_SELECT), seed);
@@ -172,8 +176,11 @@ void main() {
         vec3 f = brdfEval(MODEL_ID, M.params, wiL, wo);
         float cosS = max(wiL.z, 0.0f);
         vec3 c = beta * f * cosS * ls.value;
-        if (ls.pdf > 0.0f && lighting == LIGHTING_MIS)
-          c *= powerHeuristic(ls.pdf, bsdfPdf(SAMPLER, MODEL_ID, M.info.z, M.params, wo, wiL));
+        if (ls.pdf > 0.0f && lighting == LIGHTING_MIS) {
+          float pdfB = bsdfPdf(SAMPLER, MODEL_ID, M.info.z, M.params, wo, wiL);
+          if (GUIDING) pdfB = guideMixture(gv, ls.wi, pdfB);
+          c *= powerHeuristic(ls.pdf, pdfB);
+        }
         if (max(c.x, max(c.y, c.z)) > 0.0f) {
           // Stop short of the light so that the emitter itself never occludes.
           float tmax = ls.dist < 1.0e38f ? ls.dist * (1.0f - 1e-4f) : ls.dist;
@@ -195,9 +202,27 @@ void main() {
     vec3 weight;
     float pdf;
     float q;
-    if (!bsdfSample(SAMPLER, MODEL_ID, M.info.z, M.params, wo, !frontFace, uB, uvec4(pixel, sampleIndex, dimB, seed),
-                    wiLocal, weight, pdf, q))
+    // Path guiding: the guide with probability alpha, the BSDF sampler otherwise (one-sample MIS).
+    vec2 uG = vec2(1.0f);
+    if (GUIDING && gv.alpha > 0.0f) uG = sample2(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_GUIDE), seed);
+    bool guided = GUIDING && uG.x < gv.alpha;
+    if (guided) {
+      if (!guideSampleLocal(gv, uG.y, rngMode, pixel, sampleIndex, bounce, seed, tt, bb, ns, wiLocal)) return;
+      weight = brdfEval(MODEL_ID, M.params, wiLocal, wo) * wiLocal.z;  // f cos, over the mixture below
+      pdf = 1.0f;
+      q = 1.0f;
+    } else if (!bsdfSample(SAMPLER, MODEL_ID, M.info.z, M.params, wo, !frontFace, uB, uvec4(pixel, sampleIndex, dimB, seed),
+                           wiLocal, weight, pdf, q))
       return;
+    if (GUIDING && gv.alpha > 0.0f) {
+      // The mixture's density, for the weight f cos / pdf and for MIS at the next hit.
+      float pdfB = guided ? bsdfPdf(SAMPLER, MODEL_ID, M.info.z, M.params, wo, wiLocal) : pdf;
+      float pdfMix = guideMixture(gv, toWorld(wiLocal, tt, bb, ns), pdfB);
+      if (!(pdfMix > 0.0f)) return;
+      weight *= pdf / pdfMix;
+      if (guided) q = min(1.0f, luminance(weight));
+      pdf = pdfMix;
+    }
     vec3 wi = toWorld(wiLocal, tt, bb, ns);
     // Reflection must stay above the geometric surface (else light leaks through it); refraction
     // (only delta models transmit) must cross it, and leaves from the other side.
@@ -217,6 +242,7 @@ void main() {
       if (!throughputRoulette(bounce, beta, etaScale, uR)) return;
     }
 
+    if (GUIDING) guideRecordSample(path, bounce, wi, modelIsDelta(MODEL_ID) ? -1.0f : luminance(beta) * pdf);
     g.pathOrigin.v[path] = vec4(xo, 0.0f);
     g.pathDirection.v[path] = vec4(wi, pdf);
     g.pathThroughput.v[path] = vec4(beta, etaScale);
@@ -343,6 +369,8 @@ void main() {
     if (COMPONENT_COUNT > 3u) misPdf += componentMisPdf(MODEL_3, C3, c.w, wo, wiLocal);
   }
 
+  // Combined materials are not guided yet: their vertices only train the guide.
+  if (GUIDING) guideRecordSample(path, bounce, wi, delta ? -1.0f : luminance(beta) * misPdf);
   g.pathOrigin.v[path] = vec4(xo, 0.0f);
   g.pathDirection.v[path] = vec4(wi, misPdf);
   g.pathThroughput.v[path] = vec4(beta, etaScale);

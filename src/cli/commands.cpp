@@ -19,6 +19,7 @@
 #include "cli/cli_common.h"
 #include "io/image.h"
 #include "quadtree/sampler_tables.h"
+#include "render/guide.h"
 #include "render/render_loop.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
@@ -50,6 +51,10 @@ struct RenderArgs {
   std::string components = "albedo";
   std::string roulette = "throughput";
   std::string traversal = "auto";
+  std::string guiding = "off";
+  std::uint32_t guideTrain = 0;
+  double guideMemoryMiB = 16;
+  double guideSpatial = 12000;
   bool variance = false;
   bool validation = false;
   bool quiet = false;
@@ -85,6 +90,13 @@ int renderCommand(const RenderArgs& a) {
   parseComponentSelection(a.components, s.components);
   parseRouletteMode(a.roulette, s.roulette);
   parseTraversal(a.traversal, s.traversal);
+  s.guiding = a.guiding == "on";
+  s.guideTrainSpp = a.guideTrain;
+  s.guideSpatialThreshold = a.guideSpatial;
+  s.guideMemory = static_cast<std::uint64_t>(a.guideMemoryMiB * 1048576.0);
+  if (s.guiding && !a.resume.empty())
+    throw Error("--resume with --guiding on: a guided render cannot be resumed yet (its guide is not in the file; "
+                "issue 16)");
   // Image size: defaults follow the camera's aspect ratio when only one side (or none) is given.
   float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
   s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u);
@@ -92,6 +104,7 @@ int renderCommand(const RenderArgs& a) {
   // The samples to take: --spp, or without it and with --time as many as the budget allows.
   const std::uint32_t targetSpp = a.timeBudget > 0 && !a.sppGiven ? (1u << 30) : a.spp;
   s.spp = targetSpp;
+  if (s.guiding) s.guideTrainSpp = guideTrainingSpp(s);  // resolved once: the record states it
 
   RenderRecord base;
   base.scene = scene.sourcePath;
@@ -179,12 +192,13 @@ int renderCommand(const RenderArgs& a) {
                      sum.samplerCacheMisses, sum.samplerCacheRejected);
       std::string budget = a.timeBudget > 0 ? ", time budget " + std::to_string(a.timeBudget) + " s" : "";
       std::fprintf(stderr, "device: %s (%s); %ux%u, %s spp%s%s (%u per pass), max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
-                           "roulette %s, traversal %s\n",
+                           "roulette %s, traversal %s%s\n",
                    ctx.deviceName.c_str(), ctx.driverInfo.c_str(), s.width, s.height,
                    targetSpp == (1u << 30) ? "unlimited" : std::to_string(targetSpp).c_str(),
                    a.resume.empty() ? "" : (" (resuming from " + std::to_string(previous.spp) + ")").c_str(),
                    budget.c_str(), renderer.samplesPerPass(), s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng),
-                   samplerName(s.sampler), rouletteModeName(s.roulette), traversalName(sum.traversal));
+                   samplerName(s.sampler), rouletteModeName(s.roulette), traversalName(sum.traversal),
+                   s.guiding ? (", guiding on (" + std::to_string(sum.guideTrainSpp) + " training spp)").c_str() : "");
     }
 
     base.totalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();  // set-up
@@ -198,6 +212,16 @@ int renderCommand(const RenderArgs& a) {
     RenderLoop loop(renderer, base, previous, lo);
     loop.run();
     RenderRecord rec = loop.record(false);
+    if (const DeviceGuide* guide = renderer.guide(); guide && !a.quiet) {
+      for (const guiding::IterationReport& r : guide->reports())
+        std::fprintf(stderr, "guiding: iteration %u: %llu splats; %u regions, %llu direction nodes, %.2f MiB of %.2f MiB "
+                             "(rho %g)%s\n",
+                     r.iteration, static_cast<unsigned long long>(r.splats), r.leaves,
+                     static_cast<unsigned long long>(r.dirNodes), r.bytes / 1048576.0, s.guideMemory / 1048576.0,
+                     r.dirThreshold, r.capped ? ", memory cap reached" : "");
+      std::fprintf(stderr, "guiding: %u training spp, %.3f s of CPU time reading records, splatting and refining\n",
+                   renderer.summary().guideTrainSpp, guide->trainingSeconds());
+    }
     if (rec.interrupted)
       std::fprintf(stderr, "interrupted by %s after %u of %u spp: writing what has accumulated\n",
                    g_stopSignal == SIGINT ? "SIGINT" : "SIGTERM", rec.spp, targetSpp);
@@ -310,6 +334,9 @@ struct BenchArgs {
   int device = -1;
   std::vector<std::string> traversals{"auto"};
   std::uint32_t repeats = 1;
+  std::string guiding = "off";
+  std::uint32_t guideTrain = 1;
+  float guideAlpha = 0.5f;
   EnvironmentArgs env;
 };
 
@@ -340,6 +367,9 @@ BenchRun benchRenderOnce(vk::Context& ctx, const Scene& scene, const std::string
   s.samplesPerPass = a.samplesPerPass;
   s.timeStages = true;
   s.traversal = traversal;
+  s.guiding = a.guiding == "on";
+  s.guideTrainSpp = a.guideTrain;
+  s.guideAlpha = a.guideAlpha;
   BenchRun run;
   const auto tSetup = std::chrono::steady_clock::now();
   Renderer r(ctx, scene, s);
@@ -639,6 +669,19 @@ int runCli(int argc, char** argv) {
   render->add_option("--checkpoint", ra.checkpointSeconds, "Write the image so far to the output every this many seconds "
                                                           "(resumable with --resume; 0: never)")
       ->capture_default_str()->check(CLI::Range(0.0, 1e9));
+  render->add_option("--guiding", ra.guiding, "Path guiding (docs/guiding.md): on = sample directions from a guide "
+                                              "learned from the render's first samples (one-sample MIS with the BSDF "
+                                              "sampler), off = BSDF sampling only")
+      ->capture_default_str()->check(CLI::IsMember({"off", "on"}));
+  render->add_option("--guide-train", ra.guideTrain, "Training samples per pixel of the guide, in iterations of 1, 2, 4, "
+                                                     "... spp (0: the largest 2^k - 1 up to half of --spp, at most 127)")
+      ->capture_default_str()->check(CLI::Range(0u, 1u << 30));
+  render->add_option("--guide-memory", ra.guideMemoryMiB, "Memory cap of the guide's trees on the device, MiB")
+      ->capture_default_str()->check(CLI::Range(0.01, 4096.0));
+  render->add_option("--guide-spatial", ra.guideSpatial, "The guide's spatial split rule: a region splits after c "
+                                                         "sqrt(2^k) training splats in iteration k (Mueller et al.: "
+                                                         "12000, for 1280 x 720 images)")
+      ->capture_default_str()->check(CLI::Range(1.0, 1e12));
   render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
   render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
   render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");
@@ -665,6 +708,14 @@ int runCli(int argc, char** argv) {
                                                          "(auto, rayquery, bvh; comma-separated or repeated)")
       ->capture_default_str()->delimiter(',')->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
       ->check(CLI::IsMember(enumNames(kTraversalNames)));
+  benchRender->add_option("--guiding", ba.guiding, "Path guiding: on or off (docs/guiding.md)")
+      ->capture_default_str()->check(CLI::IsMember({"off", "on"}));
+  benchRender->add_option("--guide-train", ba.guideTrain, "Guided: training spp (1: the warm-up pass only, so that "
+                                                          "the timed passes sample a fixed guide)")
+      ->capture_default_str()->check(CLI::Range(1u, 1u << 30));
+  benchRender->add_option("--guide-alpha", ba.guideAlpha, "Guided: probability of sampling the guide (0: the guided "
+                                                          "pipelines run but never take the guide's branch)")
+      ->capture_default_str()->check(CLI::Range(0.0f, 1.0f));
   benchRender->add_option("--repeats", ba.repeats, "Repeats of every scene and traversal; with more than one, the "
                                                    "medians and ranges are printed")
       ->capture_default_str()->check(CLI::Range(1u, 1000u));

@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "../../shaders/shared/layout.h"
+#include "render/guide.h"
 #include "util/error.h"
 
 namespace nusselt {
@@ -40,8 +41,9 @@ std::uint64_t PathIntegrator::bytesFor(std::uint32_t capacity, std::size_t slots
 
 PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
                                const std::vector<std::vector<std::uint32_t>>& slotKeys, std::uint64_t pixels,
-                               std::uint32_t samplesPerPass, const std::vector<std::string>& slotNames)
-    : m_ctx(ctx), m_globals(globals), m_settings(settings), m_slotKeys(slotKeys), m_pixels(pixels) {
+                               std::uint32_t samplesPerPass, const std::vector<std::string>& slotNames,
+                               DeviceGuide* guide)
+    : m_ctx(ctx), m_globals(globals), m_settings(settings), m_slotKeys(slotKeys), m_pixels(pixels), m_guide(guide) {
   for (std::size_t s = 0; s < m_slotKeys.size(); ++s)
     m_shadeMarks.push_back("shade " + (s < slotNames.size() ? slotNames[s] : std::to_string(s)));
   m_capacity = capacityFor(settings, pixels, samplesPerPass);
@@ -56,7 +58,8 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   g.pathOrigin = make(cap * 16, "path origin")->address;
   g.pathDirection = make(cap * 16, "path direction")->address;
   g.pathThroughput = make(cap * 16, "path throughput")->address;
-  g.pathRadiance = make(cap * 16, "path radiance")->address;
+  m_pathRadiance = make(cap * 16, "path radiance");
+  g.pathRadiance = m_pathRadiance->address;
   g.pathInfo = make(cap * 16, "path info")->address;
   g.pathHit = make(cap * 16, "path hit")->address;
   g.shadowOrigin = make(cap * 16, "shadow ray origin")->address;
@@ -137,7 +140,14 @@ void PathIntegrator::createPipelines() {
   std::vector<std::uint32_t> traceSpec;
   if (m_hasAlpha) traceSpec = {0u, 0u, 0u, 0u, 0u, 0u, 0u, m_hasEscape ? 1u : 0u, m_hasTextures ? 1u : 0u, 1u};
   m_intersect = vk::createComputePipeline(m_ctx, layout, "intersect" + tracing, traceSpec);
-  if (m_hasEscape) m_escape = vk::createComputePipeline(m_ctx, layout, "escape");
+  // Constant 10 (stage_common.glsl): GUIDING, in the shade and escape stages of guided renders.
+  const std::uint32_t guiding = m_guide ? 1u : 0u;
+  if (m_hasEscape) {
+    if (m_guide)
+      m_escape = vk::createComputePipeline(m_ctx, layout, "escape",
+                                           {0, 0, 0, 0, 0, 0, 0, 1u, m_hasTextures ? 1u : 0u, 0u, guiding});
+    else m_escape = vk::createComputePipeline(m_ctx, layout, "escape");
+  }
   m_shadow = vk::createComputePipeline(m_ctx, layout, "shadow" + tracing, traceSpec);
   m_accumulate = vk::createComputePipeline(m_ctx, layout, "accumulate");
   // Only the models (and combinations) this scene uses: one specialised shade pipeline each,
@@ -165,6 +175,10 @@ void PathIntegrator::createPipelines() {
           spec.resize(7, 0u);
           spec.push_back(m_hasEscape ? 1u : 0u);
           spec.push_back(m_hasTextures ? 1u : 0u);  // constant 8: HAS_TEXTURES
+          if (guiding) {
+            spec.push_back(0u);       // constant 9: HAS_ALPHA (tracing stages only)
+            spec.push_back(guiding);  // constant 10: GUIDING
+          }
           // One module per strategy (CMakeLists.txt): shade_sN / shade_combined_sN.
           const std::string module = std::string(key[0] > 0 ? "shade_combined" : "shade") + "_s" + std::to_string(sampler);
           m_shade[s] = vk::createComputePipeline(m_ctx, layout, module, spec);
@@ -204,6 +218,8 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
   mark(cmd, nullptr);
   // All queues start empty.
   vkCmdFillBuffer(cmd, m_queues->buffer, 0, QUEUE_HEADER_UINTS * 4, 0);
+  // Path guiding's training records start as "ended here" (guiding_layout.h).
+  if (m_guide && m_guide->recording()) vkCmdFillBuffer(cmd, m_guide->records().buffer, 0, VK_WHOLE_SIZE, 0);
   vk::computeBarrier(cmd);
 
   BounceConstants pc{};
@@ -298,6 +314,8 @@ void PathIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples
         it->second += double(t[i] - t[i - 1]) * period;
       }
     }
+    // Path guiding's training: this chunk's records and final radiance, splatted in path order.
+    if (m_guide && m_guide->recording()) m_guide->consumeChunk(*m_pathRadiance, count);
     // Fold the 32-bit device counters into 64-bit totals and restart them.
     std::uint32_t* s = static_cast<std::uint32_t*>(m_stats->mapped);
     m_totals.addDevice(s);

@@ -14,14 +14,18 @@
 
 namespace nusselt {
 
+class DeviceGuide;
+
 class PathIntegrator : public Integrator {
  public:
   // slotKeys: the material table's shade slots (one specialised shade pipeline each).
+  // guide: path guiding's device state, or null (unguided: no guiding code in the pipelines).
   // pixels: the film's size; a pass of at most `samplesPerPass` samples per pixel traces
   // pixels x samples paths in chunks of at most `capacity`.
   PathIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
                  const std::vector<std::vector<std::uint32_t>>& slotKeys, std::uint64_t pixels,
-                 std::uint32_t samplesPerPass, const std::vector<std::string>& slotNames);
+                 std::uint32_t samplesPerPass, const std::vector<std::string>& slotNames,
+                 DeviceGuide* guide = nullptr);
   ~PathIntegrator() override;
 
   // Paths traced together in one chunk of a pass of `samples` samples per pixel (one indirect
@@ -67,6 +71,8 @@ class PathIntegrator : public Integrator {
   bool m_hasEscape = false;
   bool m_hasTextures = false;  // spec constant HAS_TEXTURES of the shade stages
   bool m_hasAlpha = false;     // spec constant HAS_ALPHA of the tracing stages
+  DeviceGuide* m_guide = nullptr;  // path guiding (guide.h): its records are read after every chunk
+  vk::Buffer* m_pathRadiance = nullptr;
   std::vector<vk::ComputePipeline> m_shade;  // one per slot
   VkCommandBuffer m_cmd = VK_NULL_HANDLE;
   VkFence m_fence = VK_NULL_HANDLE;

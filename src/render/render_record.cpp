@@ -100,6 +100,11 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
                   {"nusselt/envScale", r.envScale},
                   {"nusselt/envRotate", r.envRotate}};
   if (r.timeBudget > 0) meta.doubles.push_back({"nusselt/timeBudget", r.timeBudget});
+  // Path guiding (written only when on: unguided headers are as before).
+  if (r.settings.guiding) {
+    meta.strings.push_back({"nusselt/guiding", "on"});
+    meta.ints.push_back({"nusselt/guideTrainSpp", guideTrainingSpp(r.settings)});
+  }
   if (r.source == "preview") meta.doubles.push_back({"nusselt/exposure", r.displayExposure});
   return meta;
 }
@@ -163,6 +168,9 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   r.envScale = findDouble(meta, "nusselt/envScale").value_or(1);
   r.envRotate = findDouble(meta, "nusselt/envRotate").value_or(0);
   r.envSelect = findString(meta, "nusselt/envSelect").value_or("half");
+  // Absent in unguided renders (and files written before guiding existed).
+  r.settings.guiding = findString(meta, "nusselt/guiding").value_or("off") == "on";
+  r.settings.guideTrainSpp = static_cast<std::uint32_t>(findInt(meta, "nusselt/guideTrainSpp").value_or(0));
   return r;
 }
 
@@ -187,7 +195,8 @@ std::string firstDifference(const RenderRecord& a, const RenderRecord& b) {
         differ("the environment (--env, --env-color)", a.environment, b.environment),
         differ("the environment scale (--env-scale)", number(a.envScale), number(b.envScale)),
         differ("the environment rotation (--env-rotate)", number(a.envRotate), number(b.envRotate)),
-        differ("the environment's selection (--env-select)", a.envSelect, b.envSelect)})
+        differ("the environment's selection (--env-select)", a.envSelect, b.envSelect),
+        differ("path guiding (--guiding)", s.guiding ? "on" : "off", t.guiding ? "on" : "off")})
     if (!d.empty()) return d;
   return {};
 }

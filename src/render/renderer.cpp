@@ -9,6 +9,7 @@
 
 #include "../../shaders/shared/layout.h"
 #include "render/environment.h"
+#include "render/guide.h"
 #include "render/path_integrator.h"
 #include "util/error.h"
 
@@ -75,7 +76,8 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
     const std::uint64_t need = DeviceScene::bytesFor(scene.triangleCount(), lightBound + 1,
                                                      m_settings.traversal == Traversal::RayQuery) + envBytes +
                                std::max<std::size_t>(scene.materials.size(), 1) * sizeof(shared::GpuMaterial) +
-                               Film::bytesFor(pixels) + PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS);
+                               Film::bytesFor(pixels) + PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS) +
+                               (settings.guiding ? DeviceGuide::bytesFor(settings.guideMemory, capacity, settings.maxDepth) : 0);
     const std::uint64_t have = vk::deviceLocalHeapSize(m_ctx);
     // The film is the largest single buffer (16 bytes per pixel, twice): one allocation each.
     if (m_ctx.maxAllocation && pixels * 16 > m_ctx.maxAllocation)
@@ -123,18 +125,38 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   m_camera = scene.hasCamera ? scene.camera : frameScene(scene);
   writeCamera(m_camera);
 
+  if (settings.guiding) {
+    // The guide's root box: the scene's bounds.
+    glm::vec3 lo(0.0f), hi(0.0f);
+    if (!scene.positions.empty()) lo = hi = scene.positions[0];
+    for (const glm::vec3& p : scene.positions) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+    guiding::GuideSettings gs;
+    gs.memoryCap = settings.guideMemory;
+    gs.alpha = settings.guideAlpha;
+    gs.spatialThreshold = settings.guideSpatialThreshold;
+    m_guide = std::make_unique<DeviceGuide>(m_ctx, lo, hi, gs,
+                                            PathIntegrator::capacityFor(settings, pixels, m_samplesPerPass),
+                                            settings.maxDepth);
+    m_guide->fillGlobals(g);
+    m_summary.guiding = true;
+    m_summary.guideTrainSpp = guideTrainingSpp(settings);
+  }
   auto integrator = std::make_unique<PathIntegrator>(m_ctx, *m_globals, m_settings, m_materials->slotKeys(), pixels,
-                                                     m_samplesPerPass, m_materials->slotNames());
+                                                     m_samplesPerPass, m_materials->slotNames(), m_guide.get());
   m_summary.pipelineSeconds = integrator->pipelineSeconds();
   m_integrator = std::move(integrator);
   m_globals->upload();
   m_summary.deviceBytes = m_scene->deviceBytes() + m_materials->deviceBytes() + m_film->deviceBytes() +
-                          m_integrator->deviceBytes() + sizeof(Globals);
+                          m_integrator->deviceBytes() + sizeof(Globals) + (m_guide ? m_guide->deviceBytes() : 0);
 }
 
 Renderer::~Renderer() {
   vkDeviceWaitIdle(m_ctx.device);
   m_integrator.reset();
+  m_guide.reset();
   m_film.reset();
   m_materials.reset();
   m_scene.reset();
@@ -147,8 +169,20 @@ void Renderer::renderPass(std::uint32_t samples) {
   static const char* fault = std::getenv("NUSSELT_FAULT_DEVICE_LOST_AFTER");
   if (fault && m_samples >= std::strtoul(fault, nullptr, 10)) VK_CHECK(VK_ERROR_DEVICE_LOST);
   samples = samples == 0 ? m_samplesPerPass : std::min(samples, m_samplesPerPass);
+  // Path guiding's training: iteration k covers samples [2^k - 1, 2^(k+1) - 1) of the first
+  // guideTrainingSpp; a pass never crosses an iteration's end, where the guide is refined.
+  const std::uint32_t trainSpp = m_guide ? guideTrainingSpp(m_settings) : 0;
+  const bool training = m_samples < trainSpp;
+  std::uint32_t iteration = 0, iterationEnd = 0;
+  if (training) {
+    while ((2u << iteration) - 1 <= m_samples) ++iteration;
+    iterationEnd = std::min((2u << iteration) - 1, trainSpp);
+    samples = std::min(samples, iterationEnd - m_samples);
+  }
+  if (m_guide) m_guide->setRecording(training);
   m_integrator->renderPass(m_settings.sampleOffset + m_samples, samples);
   m_samples += samples;
+  if (training && m_samples == iterationEnd) m_guide->endIteration(iteration);
 }
 
 void Renderer::render(std::uint32_t spp) {

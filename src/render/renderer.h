@@ -38,6 +38,8 @@ struct SceneSummary {
   std::uint64_t samplerBytes = 0;
   std::uint32_t samplerCacheHits = 0, samplerCacheMisses = 0, samplerCacheRejected = 0;
   std::uint64_t deviceBytes = 0;
+  bool guiding = false;             // path guiding (docs/guiding.md)
+  std::uint32_t guideTrainSpp = 0;  // its training samples per pixel
 };
 
 // The traversal a render with `requested` uses on this context. Auto: ray queries where the
@@ -45,6 +47,8 @@ struct SceneSummary {
 // traversal as shader code, and there the GLSL BVH measured 1.8-3x faster: docs/performance.md)
 // and on devices without ray queries. Throws nusselt::Error for RayQuery on a context without them.
 Traversal resolveTraversal(const vk::Context& ctx, Traversal requested);
+
+class DeviceGuide;
 
 class Renderer {
  public:
@@ -59,7 +63,8 @@ class Renderer {
 
   // Traces one pass: `samples` more samples per pixel (0: samplesPerPass(); never more than
   // samplesPerPass()), sample indices from sampleOffset + samplesDone(). The image does not depend
-  // on how samples are grouped into passes.
+  // on how samples are grouped into passes (guided renders: for the same samples per pass; their
+  // passes end at the guide's training iterations, after which the guide is refined).
   void renderPass(std::uint32_t samples = 0);
   // Passes until samplesDone() reaches spp.
   void render(std::uint32_t spp);
@@ -82,6 +87,8 @@ class Renderer {
   // Extension rays per bounce over all passes so far (Integrator::raysPerBounce).
   const std::vector<std::uint64_t>& raysPerBounce() const { return m_integrator->raysPerBounce(); }
   const SceneSummary& summary() const { return m_summary; }
+  // Path guiding's state (null for unguided renders): its training reports and times.
+  const DeviceGuide* guide() const { return m_guide.get(); }
   const RenderSettings& settings() const { return m_settings; }
 
   // ---- Progressive use (the preview window) ----
@@ -113,6 +120,7 @@ class Renderer {
   std::unique_ptr<DeviceScene> m_scene;
   std::unique_ptr<MaterialTable> m_materials;
   std::unique_ptr<Film> m_film;
+  std::unique_ptr<DeviceGuide> m_guide;
   std::unique_ptr<Integrator> m_integrator;
 };
 

@@ -5,6 +5,7 @@
 // SAMPLER_*, RNG_*, COMPONENTS_*, ROULETTE_* in shaders/shared/), with one name table each: the
 // command line, the EXR header and the messages all take their names from it.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -137,7 +138,32 @@ struct RenderSettings {
   std::uint32_t samplesPerPass = 0;
   // Paths traced together in one chunk of a pass (path state memory ~150 bytes each).
   std::uint32_t maxPathsPerChunk = 1u << 20;
+  // Path guiding (issue 16, docs/guiding.md; `--guiding on`): directions from a learned
+  // incident-radiance guide, one-sample MIS with the BSDF sampler. Off by default.
+  bool guiding = false;
+  // Samples per pixel of the guide's training, in iterations of 1, 2, 4, ... (`--guide-train`);
+  // 0 = automatic (guideTrainingSpp). Training samples are rendered and kept in the image.
+  std::uint32_t guideTrainSpp = 0;
+  // The guide's trees at most this many bytes on the device (`--guide-memory`, MiB there).
+  std::uint64_t guideMemory = 16ull << 20;
+  // The guide's selection probability in regions that learned something (`--guide-alpha`): 0
+  // keeps the guided pipelines but never samples the guide (to measure their cost).
+  float guideAlpha = 0.5f;
+  // c of the guide's spatial split rule (`--guide-spatial`): a region splits after c sqrt(2^k)
+  // splats in iteration k. Mueller et al.'s 12000 suits their 1280 x 720 images; small images
+  // get few regions with it (docs/guiding.md, measurements).
+  double guideSpatialThreshold = 12000;
 };
+
+// The training samples per pixel of a guided render: settings.guideTrainSpp, or when 0 the
+// largest 2^K - 1 <= min(spp / 2, 127) (complete doubling iterations, at most half of the
+// samples, and at most 127 for renders limited by time, whose spp is open).
+inline std::uint32_t guideTrainingSpp(const RenderSettings& s) {
+  if (s.guideTrainSpp) return s.guideTrainSpp;
+  std::uint32_t budget = std::min<std::uint32_t>(s.spp / 2, 127u), t = 0;
+  while (2 * t + 1 <= budget) t = 2 * t + 1;
+  return t;
+}
 
 // What the stages counted, summed over passes: one field per entry of NUSSELT_STATS (layout.h).
 struct RenderStats {

@@ -1,0 +1,262 @@
+// guiding.h: the path guide's look-ups (issue 16, docs/guiding.md), shared by the CPU (tests,
+// the trainer's splats) and the GPU (shade stage): the equal-area map of the sphere, the spatial
+// descent, the directional quadtree's density per steradian and its sampling, and the one-sample
+// MIS mixture with the BRDF sampler. Arrays: guiding_layout.h; builder: src/guiding/guide_tree.cpp.
+//
+// Buffer access: GLSL passes the GpuGuide (its buffer references), C++ a GuideHostView (the struct
+// plus host pointers to the arrays), as envmap.h does.
+#ifndef NUSSELT_GUIDING_H
+#define NUSSELT_GUIDING_H
+#include "guiding_layout.h"
+#include "rng.h"
+
+#ifdef __cplusplus
+SHARED_BEGIN
+struct GuideHostView {
+  GpuGuide g{};
+  const GuideSpatialNode* spatial = nullptr;
+  const GuideDirNode* dir = nullptr;
+};
+typedef GuideHostView GuideView;
+SHARED_END
+#define GUIDE_VIEW_INFO(G) (G.g)
+#define GUIDE_SPATIAL(G, i) (G.spatial[i])
+#define GUIDE_DIR(G, i) (G.dir[i])
+#else
+#define GuideView GpuGuide
+#define GUIDE_VIEW_INFO(G) (G)
+#define GUIDE_SPATIAL(G, i) (G.spatial.v[i])
+#define GUIDE_DIR(G, i) (G.dir.v[i])
+#endif
+
+SHARED_BEGIN
+
+// The guide's descents draw further numbers from their own stream: dimension | this bit
+// (the quadtree sampler's rejection stream is RNG_REJECTION_STREAM).
+#define RNG_GUIDE_STREAM 0x40000000u
+#define NUSSELT_INV_4PI 0.07957747154594767f
+
+// ---- The equal-area map of the sphere ----------------------------------------------------------
+
+// Map point of a unit direction: (u, v) = ((d.z + 1) / 2, atan2(d.y, d.x) / (2 pi) mod 1), in
+// [0, 1)^2 (Lambert's cylindrical equal-area projection: d omega = 4 pi du dv).
+SHARED_FN vec2 guideDirectionToSquare(vec3 d) {
+  float u = clamp(0.5f * (d.z + 1.0f), 0.0f, NUSSELT_ONE_MINUS_EPS);
+  float v = portableAtan2(d.y, d.x) * (1.0f / NUSSELT_TWO_PI);
+  if (v < 0.0f) v += 1.0f;
+  return vec2(u, clamp(v, 0.0f, NUSSELT_ONE_MINUS_EPS));
+}
+
+// The unit direction at map point p (inverse of guideDirectionToSquare).
+SHARED_FN vec3 guideSquareToDirection(vec2 p) {
+  float z = clamp(2.0f * p.x - 1.0f, -1.0f, 1.0f);
+  float r = cosFromSin(z);
+  float phi = NUSSELT_TWO_PI * p.y;
+  return vec3(r * cos(phi), r * sin(phi), z);
+}
+
+// ---- Space ----------------------------------------------------------------------------------------
+
+// info of the spatial leaf whose box holds x (guiding_layout.h: (GUIDE_SPATIAL_LEAF, root,
+// alpha bits, 0)). Points outside the root box go to the nearest leaf along each split. A tree
+// deeper than the loop bound (never built) gives an unguided region (alpha 0).
+SHARED_FN uvec4 guideLeafInfo(GuideView G, vec3 x) {
+  vec3 lo = vec3(GUIDE_VIEW_INFO(G).boundsMin.x, GUIDE_VIEW_INFO(G).boundsMin.y, GUIDE_VIEW_INFO(G).boundsMin.z);
+  vec3 hi = vec3(GUIDE_VIEW_INFO(G).boundsMax.x, GUIDE_VIEW_INFO(G).boundsMax.y, GUIDE_VIEW_INFO(G).boundsMax.z);
+  uint node = 0u;
+  for (uint d = 0u; d < GUIDE_MAX_SPATIAL_DEPTH; ++d) {
+    uvec4 info = GUIDE_SPATIAL(G, node).info;
+    if (info.x == GUIDE_SPATIAL_LEAF) return info;
+    uint a = info.x;
+    float mid = 0.5f * (lo[a] + hi[a]);
+    if (x[a] < mid) {
+      hi[a] = mid;
+      node = info.y;
+    } else {
+      lo[a] = mid;
+      node = info.y + 1u;
+    }
+  }
+  return uvec4(GUIDE_SPATIAL_LEAF, 0u, 0u, 0u);
+}
+
+// ---- Directions -----------------------------------------------------------------------------------
+
+// Density per unit area of the map at p in [0, 1)^2 of the quadtree rooted at `root`: the
+// product over the descent of 4 x (child's mass / node's mass). 0 where a cell has no mass or
+// the tree has none.
+SHARED_FN float guideSquarePdf(GuideView G, uint root, vec2 p) {
+  uint node = root;
+  float x0 = 0.0f;
+  float y0 = 0.0f;
+  float size = 1.0f;
+  float pdf = 1.0f;
+  for (uint d = 0u; d <= GUIDE_MAX_DIR_DEPTH; ++d) {
+    GuideDirNode N = GUIDE_DIR(G, node);
+    float total = N.mass.x + N.mass.y + N.mass.z + N.mass.w;
+    if (!(total > 0.0f)) return 0.0f;
+    size *= 0.5f;
+    uint c = 0u;
+    if (p.x >= x0 + size) {
+      c += 1u;
+      x0 += size;
+    }
+    if (p.y >= y0 + size) {
+      c += 2u;
+      y0 += size;
+    }
+    pdf *= 4.0f * N.mass[c] / total;
+    if (N.child[c] == 0u) return pdf;
+    node = N.child[c];
+  }
+  return 0.0f;
+}
+
+// Density per steradian with which guideDirSample draws the unit direction d.
+SHARED_FN float guideDirPdf(GuideView G, uint root, vec3 d) {
+  return guideSquarePdf(G, root, guideDirectionToSquare(d)) * NUSSELT_INV_4PI;
+}
+
+// Child of a node by its masses with the uniform number u in [0, 1), which is rescaled to the
+// chosen child's share (one number serves several levels). A child whose interval is empty in
+// floats is never chosen; when rounding puts u x total at or past the total, the heaviest child
+// is taken. share = the chosen child's mass / the node's (0: the node has no mass).
+SHARED_FN uint guidePickChild(vec4 m, INOUT(float) u, OUT(float) share) {
+  float total = m.x + m.y + m.z + m.w;
+  share = 0.0f;
+  if (!(total > 0.0f)) return 0u;
+  float t = u * total;
+  float e1 = m.x;
+  float e2 = m.x + m.y;
+  float e3 = m.x + m.y + m.z;
+  uint c;
+  float below;
+  if (t < e1) { c = 0u; below = 0.0f; }
+  else if (t < e2) { c = 1u; below = e1; }
+  else if (t < e3) { c = 2u; below = e2; }
+  else if (t < total) { c = 3u; below = e3; }
+  else {
+    c = 0u;
+    if (m.y > m[c]) c = 1u;
+    if (m.z > m[c]) c = 2u;
+    if (m.w > m[c]) c = 3u;
+    below = t - m[c];
+  }
+  u = clamp((t - below) / m[c], 0.0f, NUSSELT_ONE_MINUS_EPS);
+  share = m[c] / total;
+  return c;
+}
+
+// Draws a unit direction d (world) with density guideDirPdf from the quadtree rooted at `root`:
+// a cell by descent in proportion to the masses (uDescent, rescaled at each level; once the
+// path's probability falls below 2^-10 a fresh number from the guide's stream of rngKey = (pixel,
+// sample, dimension, seed) takes over, so that a cell far below 2^-24 of the total keeps its
+// odds), then a uniform point of the cell (uCell). False when the tree has no mass.
+SHARED_FN bool guideDirSample(GuideView G, uint root, float uDescent, vec2 uCell, uvec4 rngKey, OUT(vec3) d) {
+  d = vec3(0.0f, 0.0f, 1.0f);
+  uint node = root;
+  float x0 = 0.0f;
+  float y0 = 0.0f;
+  float size = 1.0f;
+  float u = uDescent;
+  float pathShare = 1.0f;
+  for (uint depth = 0u; depth <= GUIDE_MAX_DIR_DEPTH; ++depth) {
+    GuideDirNode N = GUIDE_DIR(G, node);
+    if (pathShare < 1.0f / 1024.0f) {
+      uvec4 h = pcg4d(uvec4(rngKey.x, rngKey.y, (rngKey.z & 0xffffu) | RNG_GUIDE_STREAM, rngKey.w + depth));
+      u = float(h.x >> 8u) * (1.0f / 16777216.0f);
+      pathShare = 1.0f;
+    }
+    float share;
+    uint c = guidePickChild(N.mass, u, share);
+    if (!(share > 0.0f)) return false;
+    pathShare *= share;
+    size *= 0.5f;
+    if ((c & 1u) != 0u) x0 += size;
+    if ((c & 2u) != 0u) y0 += size;
+    if (N.child[c] == 0u) {
+      d = guideSquareToDirection(vec2(x0 + uCell.x * size, y0 + uCell.y * size));
+      return true;
+    }
+    node = N.child[c];
+  }
+  return false;
+}
+
+// ---- One-sample MIS with the BRDF sampler ---------------------------------------------------------
+// The guide is chosen with probability alpha, the material's own sampler otherwise; both the
+// sample's weight f cos / p and the MIS weights against light sampling use the mixture's density
+// (Veach's one-sample model, section 9.2.4). The BRDF sampler's density is positive wherever
+// f cos is (every strategy of bsdf_sampling.h is unbiased on its own), so the mixture is too for
+// alpha < 1: the guide needs no floor of its own, and a cell the training never reached is still
+// sampled through the BRDF.
+SHARED_FN float guideMixturePdf(float alpha, float pdfGuide, float pdfBsdf) {
+  return alpha * pdfGuide + (1.0f - alpha) * pdfBsdf;
+}
+
+SHARED_END
+
+// ---- The shade and escape stages' side (GLSL): the guide at a vertex, training records -------------
+#if !defined(__cplusplus) && !defined(NUSSELT_STANDALONE_KERNEL)
+// The guide's region at a surface point: its quadtree's root and the selection probability
+// alpha of the guide there (0: the region has learned nothing and is not guided).
+struct GuideVertex {
+  uint root;
+  float alpha;
+};
+
+GuideVertex guideVertex(vec3 x) {
+  uvec4 info = guideLeafInfo(g.guide.v[0], x);
+  GuideVertex v;
+  v.root = info.y;
+  v.alpha = uintBitsToFloat(info.z);
+  return v;
+}
+
+// The mixture's density for the world direction w whose BRDF-sampler density is pdfBsdf.
+float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) {
+  if (!(v.alpha > 0.0f)) return pdfBsdf;
+  return guideMixturePdf(v.alpha, guideDirPdf(g.guide.v[0], v.root, w), pdfBsdf);
+}
+
+// A direction from the guide of region v, in the local frame (t, b, n) of the shading point:
+// uDescent = the tree descent's number; the point in the cell comes from the bounce's
+// RNG_DIM_GUIDE_CELL. False (the path ends) when the region has no mass or the direction lies
+// below the surface, where f cos = 0: the mixture's density still counts the guide's share there.
+bool guideSampleLocal(GuideVertex v, float uDescent, uint rngMode, uint pixel, uint sampleIndex, uint bounce, uint seed,
+                      vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
+  wiLocal = vec3(0.0f, 0.0f, 1.0f);
+  uint dim = rngDimension(bounce, RNG_DIM_GUIDE_CELL);
+  vec2 uCell = sample2(rngMode, pixel, sampleIndex, dim, seed);
+  vec3 w;
+  if (!guideDirSample(g.guide.v[0], v.root, uDescent, uCell, uvec4(pixel, sampleIndex, dim, seed), w)) return false;
+  wiLocal = toLocal(w, t, b, n);
+  return wiLocal.z > 0.0f;
+}
+
+// Training record k = bounce of this path (guiding_layout.h): its ray arrived at x with the path
+// radiance as it stands (call before the stage adds anything); the path ends here unless
+// guideRecordSample follows.
+void guideRecordArrival(uint path, uint bounce, vec3 x) {
+  uint n = g.guide.v[0].info.x;
+  if (bounce >= n) return;
+  GuideRecords R = g.guide.v[0].records;
+  uint i = (path * n + bounce) * 2u;
+  R.v[i] = vec4(x, luminance(g.pathRadiance.v[path].xyz));
+  R.v[i + 1u] = vec4(0.0f);
+}
+
+// The path goes on from vertex `bounce` in the world direction wi; value = luminance of the new
+// throughput x the sample's density per steradian, or -1 (a delta sample: not splatted). The next
+// record's arrival is reset to -1 (nothing arrived) until a stage writes it.
+void guideRecordSample(uint path, uint bounce, vec3 wi, float value) {
+  uint n = g.guide.v[0].info.x;
+  if (bounce >= n) return;
+  GuideRecords R = g.guide.v[0].records;
+  uint i = (path * n + bounce) * 2u;
+  R.v[i + 1u] = vec4(wi, value > 0.0f ? value : -1.0f);  // 0 would read as "ended here"
+  if (bounce + 1u < n) R.v[i + 2u].w = -1.0f;
+}
+#endif
+
+#endif

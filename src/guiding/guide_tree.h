@@ -1,0 +1,135 @@
+// guide_tree.h: the path guide's CPU side (issue 16, docs/guiding.md): a binary tree over space
+// whose leaves own directional quadtrees over the sphere (Mueller, Gross and Novak, "Practical
+// Path Guiding", EGSR 2017), trained from splats of incident radiance, refined between training
+// iterations and flattened into the arrays of shaders/shared/guiding_layout.h, which the shade
+// stage samples with shaders/shared/guiding.h.
+//
+// Each leaf keeps two quadtrees: `sampling` (what the GPU samples during an iteration) and
+// `building` (what the iteration's splats go into). At the end of iteration k (endIteration):
+//   1. sampling := building (its structure and energies);
+//   2. a leaf that received more than c sqrt(2^k) splats is split in two at the midpoint of its
+//      box's longest axis (recursively, the splat count halving), both halves keeping its trees;
+//   3. building := sampling's structure refined by energy (a cell holding more than rho of its
+//      tree's energy is split, down to maxDirDepth), energies zero;
+// within the memory cap (the flat arrays' bytes, spatial and directional): spatial splits stop
+// at the cap, and rho doubles until the refined trees fit.
+// Everything runs in a fixed order: the same splats give the same trees, bit for bit.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "../../shaders/shared/guiding.h"
+
+namespace nusselt::guiding {
+
+struct GuideSettings {
+  // c of the spatial split rule (Mueller et al.: 12000): a leaf splits once it received more than
+  // c sqrt(2^k) splats in iteration k (k = 0, 1, ...): the splats per leaf grow with the square
+  // root of the samples, so leaves get both smaller and better trained as training goes on.
+  double spatialThreshold = 12000;
+  // rho (Mueller et al.: 0.01): a directional cell holding more than this share of its tree's
+  // energy is split: at most about 4 / rho leaves of comparable energy per tree.
+  double dirThreshold = 0.01;
+  // Depth of the finest directional cell (2^-20 of the map's side).
+  std::uint32_t maxDirDepth = GUIDE_MAX_DIR_DEPTH;
+  // Depth of the deepest spatial node (its descent loop allows GUIDE_MAX_SPATIAL_DEPTH).
+  std::uint32_t maxSpatialDepth = 48;
+  // Bytes of the flat arrays (GuideSpatialNode + GuideDirNode) at most: 16 MiB by default.
+  std::uint64_t memoryCap = 16ull << 20;
+  // Probability of choosing the guide in a region that has learned something (one-sample MIS
+  // with the BRDF sampler); 0.5 until it is learned per region.
+  float alpha = 0.5f;
+};
+
+// A quadtree over the map [0, 1)^2; node 0 is the root. energy[c] of a node = the energy of
+// child c's whole cell; child[c] = its node index, 0 for a leaf cell.
+class DirTree {
+ public:
+  struct Node {
+    std::array<double, 4> energy{};
+    std::array<std::uint32_t, 4> child{};
+  };
+  DirTree() : m_nodes(1) {}
+  // Adds value (>= 0) to the finest cell holding p (and to every cell above it).
+  void splat(glm::vec2 p, double value);
+  double total() const;
+  // This tree's structure refined by its energy, with zero energies: a cell is split when it holds
+  // more than `threshold` of the total and is shallower than maxDepth (a cell that was a leaf here
+  // is taken to hold its energy uniformly). A tree without energy stays one node.
+  DirTree refined(double threshold, std::uint32_t maxDepth) const;
+  std::size_t nodeCount() const { return m_nodes.size(); }
+  const std::vector<Node>& nodes() const { return m_nodes; }
+  // Depth of the deepest leaf cell (the root's children are at depth 1).
+  std::uint32_t depth() const;
+
+ private:
+  std::vector<Node> m_nodes;
+};
+
+struct IterationReport {
+  std::uint32_t iteration = 0;
+  std::uint64_t splats = 0;         // splats of the iteration
+  std::uint32_t leaves = 0;         // spatial leaves after it
+  std::uint64_t dirNodes = 0;       // directional nodes the GPU samples from
+  std::uint64_t bytes = 0;          // flat arrays' bytes (what the cap bounds)
+  double dirThreshold = 0;          // rho used (raised above the setting when the cap bit)
+  bool capped = false;              // the memory cap stopped a split or raised rho
+};
+
+class GuideTree {
+ public:
+  // The root box: [lo, hi] (the scene's bounds, made non-degenerate).
+  GuideTree(glm::vec3 lo, glm::vec3 hi, const GuideSettings& settings);
+
+  // One splat: value (>= 0) = the radiance estimate arriving at x from direction d divided by the
+  // density per steradian with which d was sampled; counts one sample of x's leaf.
+  void splat(glm::vec3 x, glm::vec3 d, double value);
+  // The end of training iteration `iteration` (0, 1, ...): build, refine, report.
+  IterationReport endIteration(std::uint32_t iteration);
+
+  // The flat arrays of the sampling trees (guiding_layout.h); leaf alpha = settings.alpha where
+  // the tree has energy, 0 elsewhere.
+  void flatten(std::vector<shared::GuideSpatialNode>& spatial, std::vector<shared::GuideDirNode>& dir) const;
+  // Bytes of the flat arrays.
+  std::uint64_t bytes() const;
+  std::uint32_t leafCount() const { return static_cast<std::uint32_t>(m_leaves.size()); }
+  // The leaf (index into the leaves) whose box holds x: the same float arithmetic as guideLeafInfo.
+  std::uint32_t findLeaf(glm::vec3 x) const;
+  const DirTree& samplingTree(std::uint32_t leaf) const { return m_leaves[leaf].sampling; }
+  const DirTree& buildingTree(std::uint32_t leaf) const { return m_leaves[leaf].building; }
+  double leafSamples(std::uint32_t leaf) const { return m_leaves[leaf].samples; }
+  glm::vec3 boundsMin() const { return m_lo; }
+  glm::vec3 boundsMax() const { return m_hi; }
+  const GuideSettings& settings() const { return m_settings; }
+
+ private:
+  struct SpatialNode {
+    std::uint32_t axis = GUIDE_SPATIAL_LEAF;  // 0..2 inner, GUIDE_SPATIAL_LEAF leaf
+    std::uint32_t child = 0;                  // inner: first child node
+    std::uint32_t leaf = 0;                   // leaf: index into m_leaves
+    std::uint32_t depth = 0;
+    glm::vec3 lo{0.0f}, hi{0.0f};
+  };
+  struct Leaf {
+    DirTree sampling, building;
+    double samples = 0;
+  };
+  std::uint64_t bytesOf(std::size_t spatialNodes, std::uint64_t dirNodes) const;
+
+  GuideSettings m_settings;
+  glm::vec3 m_lo, m_hi;
+  std::vector<SpatialNode> m_nodes;
+  std::vector<Leaf> m_leaves;
+  std::uint64_t m_splats = 0;
+};
+
+// Splats the training records of `paths` paths (guiding_layout.h: recordsPerPath records of two
+// vec4 per path) with their final radiance (pathRadiance, rgb) into the tree, paths in order.
+// Returns the number of splats.
+std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_t recordsPerPath,
+                         const glm::vec4* pathRadiance, std::uint32_t paths);
+
+}  // namespace nusselt::guiding

@@ -1,0 +1,69 @@
+// guide.h: the path guide of a render (issue 16, docs/guiding.md): the trainer's tree
+// (src/guiding/guide_tree.h), its flat arrays on the device, the per-path training records the
+// shade stages write, and the training schedule: iterations of 1, 2, 4, ... samples per pixel
+// (Mueller et al. 2017), each trained from the paths of the iteration before it (their records
+// splatted on the CPU in path order, so the same settings give bit-identical images).
+#pragma once
+#include <chrono>
+#include <cstdint>
+#include <vector>
+
+#include "guiding/guide_tree.h"
+#include "vk/vk.h"
+
+namespace nusselt {
+
+namespace shared {
+struct Globals;
+}
+
+class DeviceGuide {
+ public:
+  // A guide over the box [lo, hi] for a render whose chunks hold at most `pathCapacity` paths of
+  // at most maxDepth + 1 vertices. Throws nusselt::Error when the buffers do not fit the device.
+  DeviceGuide(vk::Context& ctx, glm::vec3 lo, glm::vec3 hi, const guiding::GuideSettings& settings,
+              std::uint32_t pathCapacity, std::uint32_t maxDepth);
+  ~DeviceGuide();
+  DeviceGuide(const DeviceGuide&) = delete;
+  DeviceGuide& operator=(const DeviceGuide&) = delete;
+
+  // Device bytes a guide needs (before allocating): the cap, the records and the GpuGuide.
+  static std::uint64_t bytesFor(std::uint64_t memoryCap, std::uint32_t pathCapacity, std::uint32_t maxDepth);
+  static std::uint32_t recordsPerPath(std::uint32_t maxDepth);
+
+  void fillGlobals(shared::Globals& g) const;
+  // Whether the shade stages write training records (the GpuGuide's info.x).
+  void setRecording(bool on);
+  bool recording() const { return m_recording; }
+  // The records' buffer (cleared before every recorded chunk: a path whose camera ray leaves the
+  // scene writes no record, and its slot must read "ended", not a previous chunk's path).
+  const vk::Buffer& records() const { return m_records; }
+  // After a chunk of `paths` paths (recording): splats their records with their final radiance
+  // (the path radiance buffer).
+  void consumeChunk(const vk::Buffer& pathRadiance, std::uint32_t paths);
+  // The end of training iteration k: refines the tree and uploads the arrays the shade stages
+  // sample from next.
+  void endIteration(std::uint32_t iteration);
+
+  const std::vector<guiding::IterationReport>& reports() const { return m_reports; }
+  double trainingSeconds() const { return m_seconds; }  // CPU time of downloads, splats, refinement
+  std::uint64_t deviceBytes() const;
+  const guiding::GuideTree& tree() const { return m_tree; }
+
+ private:
+  void upload();
+
+  vk::Context& m_ctx;
+  guiding::GuideTree m_tree;
+  std::uint32_t m_recordsPerPath = 0;
+  std::uint32_t m_capacity = 0;
+  bool m_recording = false;
+  vk::Buffer m_info;     // one GpuGuide (host visible)
+  vk::Buffer m_arrays;   // spatial nodes then directional nodes (the cap's bytes)
+  vk::Buffer m_records;  // capacity x recordsPerPath x 2 vec4
+  std::vector<glm::vec4> m_hostRecords, m_hostRadiance;
+  std::vector<guiding::IterationReport> m_reports;
+  double m_seconds = 0;
+};
+
+}  // namespace nusselt

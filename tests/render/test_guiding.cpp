@@ -1,0 +1,103 @@
+// Path guiding (issue 16, docs/guiding.md) in whole renders: the guided estimator is unbiased (its
+// image equals the unguided one within their variances: per-block z-tests with a binomial bound,
+// and a z-test on the difference of the image means), it is deterministic, and it learned
+// something (the test would otherwise compare BSDF sampling with itself).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "../support/test_support.h"
+#include "render/environment.h"
+#include "render/guide.h"
+
+using namespace nusselt;
+
+namespace {
+
+// z of the difference of two images' means, from the per-pixel variances of the mean the film
+// records (pixels independent: the variance of a mean of n pixels is the sum of theirs / n^2).
+double meanDifferenceZ(const Image& a, const Image& b) {
+  double ma = 0, mb = 0, va = 0, vb = 0;
+  const double n = double(a.rgb.size());
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) {
+    ma += a.rgb[i];
+    mb += b.rgb[i];
+    va += a.variance[i];
+    vb += b.variance[i];
+  }
+  return (ma / n - mb / n) / std::sqrt((va + vb) / (n * n));
+}
+
+// A guided and an unguided render of `scene` (different seeds: independent estimates) agree.
+void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, std::uint32_t depth, int block) {
+  RenderSettings s;
+  s.width = s.height = size;
+  s.spp = spp;
+  s.maxDepth = depth;
+  s.seed = 21;
+  test::Rendered plain = test::render(scene, s);
+  s.seed = 22;
+  s.guiding = true;
+  Renderer r(test::context(), scene, s);
+  r.render(s.spp);
+  Image guided = r.image(true);
+  ASSERT_NE(r.guide(), nullptr);
+  ASSERT_FALSE(r.guide()->reports().empty());
+  EXPECT_GT(r.guide()->reports().back().dirNodes, 1u) << "the guide must have learned a distribution";
+  EXPECT_EQ(r.stats().nonFiniteSamples, 0u);
+  // Per block of block x block pixels: significance 0.01 per block, 0.001 for the binomial bound.
+  std::string msg = test::compareImagesStatistically(guided, plain.image, 0.01, 0.001, block);
+  EXPECT_TRUE(msg.empty()) << msg;
+  // The whole image's mean: two-sided, significance 0.001.
+  const double z = meanDifferenceZ(guided, plain.image);
+  EXPECT_GT(test::normalPValue(z), 0.001) << "z = " << z;
+  double sum = 0;
+  for (float v : guided.rgb) sum += v;
+  EXPECT_GT(sum, 0.0);
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+}  // namespace
+
+// The Cornell box lit only indirectly (its light faces the ceiling): guiding's home ground.
+TEST(Guiding, UnbiasedOnIndirectlyLitCornellBox) {
+  expectUnbiased(test::loadTestScene("scenes/cornell/cornell-indirect.glb"), 32, 64, 6, 4);
+}
+
+// Combined materials (not guided, they train), mirror and dielectric components (never guided).
+TEST(Guiding, UnbiasedWithCombinedAndDeltaMaterials) {
+  expectUnbiased(test::loadTestScene("scenes/tests/combined.gltf"), 24, 32, 5, 4);
+}
+
+// An environment (the escape stage writes the records of rays that leave the scene), a Lambert
+// and a mirror sphere.
+TEST(Guiding, UnbiasedUnderAnEnvironment) {
+  Scene scene = test::loadTestScene("scenes/tests/environment.gltf");
+  scene.environment.kind = EnvironmentKind::Uniform;
+  scene.environment.color = glm::vec3(0.8f, 0.9f, 1.0f);
+  expectUnbiased(scene, 32, 64, 4, 4);
+}
+
+TEST(Guiding, SameSeedIsBitIdentical) {
+  Scene scene = test::loadTestScene("scenes/cornell/cornell-indirect.glb");
+  RenderSettings s;
+  s.width = 24;
+  s.height = 20;
+  s.spp = 16;
+  s.maxDepth = 5;
+  s.seed = 3;
+  s.guiding = true;
+  test::Rendered a = test::render(scene, s);
+  test::Rendered b = test::render(scene, s);
+  ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
+  EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
+  EXPECT_EQ(a.stats.rays, b.stats.rays);
+  // And guiding changed the samples (the same seed unguided gives another image).
+  s.guiding = false;
+  test::Rendered c = test::render(scene, s);
+  EXPECT_NE(0, std::memcmp(a.image.rgb.data(), c.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+
