@@ -55,6 +55,7 @@ struct RenderArgs {
   std::uint32_t guideTrain = 0;
   double guideMemoryMiB = 16;
   double guideSpatial = 12000;
+  float guideAlpha = 0.5f;
   bool variance = false;
   bool validation = false;
   bool quiet = false;
@@ -93,6 +94,7 @@ int renderCommand(const RenderArgs& a) {
   s.guiding = a.guiding == "on";
   s.guideTrainSpp = a.guideTrain;
   s.guideSpatialThreshold = a.guideSpatial;
+  s.guideAlpha = a.guideAlpha;
   s.guideMemory = static_cast<std::uint64_t>(a.guideMemoryMiB * 1048576.0);
   if (s.guiding && !a.resume.empty())
     throw Error("--resume with --guiding on: a guided render cannot be resumed yet (its guide is not in the file; "
@@ -682,6 +684,10 @@ int runCli(int argc, char** argv) {
                                                          "sqrt(2^k) training splats in iteration k (Mueller et al.: "
                                                          "12000, for 1280 x 720 images)")
       ->capture_default_str()->check(CLI::Range(1.0, 1e12));
+  render->add_option("--guide-alpha", ra.guideAlpha, "Probability of sampling the guide where it learned something "
+                                                     "(one-sample MIS with the BSDF sampler; below 1 keeps the render "
+                                                     "unbiased where the guide has no mass)")
+      ->capture_default_str()->check(CLI::Range(0.0f, 0.99f));
   render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
   render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
   render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");

@@ -99,5 +99,3 @@ TEST(Guiding, SameSeedIsBitIdentical) {
   EXPECT_NE(0, std::memcmp(a.image.rgb.data(), c.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
   EXPECT_EQ(test::validationMessages(), 0u);
 }
-
-
