@@ -88,55 +88,20 @@ SHARED_FN float bsdfPdf(uint strategy, uint model, uint quadSet, BrdfParams p, v
   return cosineHemispherePdf(wi);
 }
 
-// inside: the path arrived from the inside (the back side of the surface's front face), which
-// matters for refraction only: the dielectric's relative index is then 1/eta.
-// rngKey = (pixel, sample index, dimension, seed) of the draw: the quadtree's rejection loop
-// takes its further numbers from its own stream of that key.
-SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p, vec3 wo, bool inside, vec2 u,
-                          uvec4 rngKey, OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(float) continuation) {
+// Draws wi for the known direction wo (wo.z > 0; a model that is not delta) with strategy s (a
+// SAMPLER_* id, after effectiveSampler) and two uniform numbers u in [0, 1), and returns the
+// density pdf and f = f(wi, wo) (the quadtree returns the value its rejection test evaluated).
+// rngKey = (pixel or sample, sample index, dimension, seed) keys the quadtree's rejection stream.
+// False for a failed sample. The one strategy switch: the shade stage (through bsdfSample), the
+// sample tool (shaders/tools/sample_tool.comp) and `nusselt sample --cpu` all draw through it.
+SHARED_FN bool strategySample(uint s, uint model, uint set, BrdfParams p, vec3 wo, vec2 u, uvec4 rngKey, OUT(vec3) wi,
+                              OUT(float) pdf, OUT(vec3) f) {
   wi = vec3(0.0f, 0.0f, 1.0f);
-  weight = vec3(0.0f);
   pdf = 0.0f;
-  continuation = 0.0f;
-  if (wo.z <= 0.0f) return false;
-  if (model == MODEL_MIRROR) {
-    wi = brdfReflectZ(wo);
-    weight = mirrorReflectance(p, wo.z);
-    continuation = min(1.0f, luminance(weight));
-    return true;
-  }
-  if (model == MODEL_DIELECTRIC) {
-    // Reflect with probability R (Fresnel), refract otherwise: weight 1 for either, times the
-    // radiance scaling (n_wo / n_wi)^2 across the interface for refraction (catalogue 2.19).
-    float eta = brdfParam(p, DIELECTRIC_ETA);
-    float etaRel = inside ? 1.0f / eta : eta;  // n(wi side) / n(wo side) for transmission
-    float R = fresnelDielectric(wo.z, etaRel);
-    vec3 t;
-    if (u.x < R || !dielectricRefract(etaRel, wo, t)) {
-      wi = brdfReflectZ(wo);
-      weight = vec3(1.0f);
-    } else {
-      wi = t;
-      weight = vec3(1.0f / (etaRel * etaRel));
-    }
-    // The walk does not end at a lossless interface: the radiance scaling is not an albedo.
-    continuation = 1.0f;
-    return true;
-  }
-  uint s = effectiveSampler(strategy, quadSet);
+  f = vec3(0.0f);
 #if NUSSELT_WITH_QUADTREE
-  if (s == SAMPLER_QUADTREE) {
-    vec3 f;
-    if (!quadSample(quadSet, model, p, wo, u, rngKey, wi, pdf, f) || !(pdf > 0.0f)) return false;
-    weight = f * (wi.z / pdf);
-    // The random-walk source's roulette: continue with the tabulated directional albedo. With
-    // sampling proportional to f cos the weight's luminance is that albedo, so surviving paths
-    // of a grey BRDF carry weight 1.
-    continuation = min(1.0f, quadAlbedo(quadSet, wo.z, portableAtan2(wo.y, wo.x)));
-    return true;
-  }
+  if (s == SAMPLER_QUADTREE) return quadSample(set, model, p, wo, u, rngKey, wi, pdf, f) && pdf > 0.0f;
 #endif
-  float cont = -1.0f;  // < 0: min(1, luminance(weight))
   if (false) {
 #if NUSSELT_WITH_ANALYTIC
   } else if (s == SAMPLER_ANALYTIC) {
@@ -144,9 +109,7 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
 #endif
 #if defined(NUSSELT_HAS_TABULATED) && NUSSELT_WITH_TABULATED
   } else if (s == SAMPLER_TABULATED) {
-    if (!tabSample(quadSet, wo, u, wi, pdf)) return false;
-    float a = tabAlbedo(quadSet, wo);
-    if (a > 0.0f) cont = min(1.0f, a);
+    if (!tabSample(set, wo, u, wi, pdf)) return false;
 #endif
 #if NUSSELT_WITH_UNIFORM
   } else if (s == SAMPLER_UNIFORM) {
@@ -161,20 +124,45 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
     pdf = cosineHemispherePdf(wi);
   }
   if (!(pdf > 0.0f) || wi.z <= 0.0f) return false;
-  weight = brdfEval(model, p, wi, wo) * (wi.z / pdf);
-  // Without a tabulated albedo, the sample weight's luminance (its estimate) is the continuation.
-  continuation = cont >= 0.0f ? cont : min(1.0f, luminance(weight));
+  f = brdfEval(model, p, wi, wo);
   return true;
 }
 
-// The factor by which a refraction's radiance scaling (n_wo / n_wi)^2 is undone for the throughput
-// roulette (pbrt's and Mitsuba's etaScale): (n_wi / n_wo)^2 for a sample of `model` that crossed the
-// surface, 1 for everything else (only the dielectric transmits).
-SHARED_FN float transmissionEtaScale(uint model, BrdfParams p, bool inside) {
-  if (model != MODEL_DIELECTRIC) return 1.0f;
-  float eta = brdfParam(p, DIELECTRIC_ETA);
-  float etaRel = inside ? 1.0f / eta : eta;
-  return etaRel * etaRel;
+// inside: the path arrived from the inside (the back side of the surface's front face), which
+// matters for refraction only: the dielectric's relative index is then 1/eta.
+// rngKey = (pixel, sample index, dimension, seed) of the draw: the quadtree's rejection loop
+// takes its further numbers from its own stream of that key.
+SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p, vec3 wo, bool inside, vec2 u,
+                          uvec4 rngKey, OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(float) continuation) {
+  wi = vec3(0.0f, 0.0f, 1.0f);
+  weight = vec3(0.0f);
+  pdf = 0.0f;
+  continuation = 0.0f;
+  if (wo.z <= 0.0f) return false;
+  if (modelIsDelta(model)) return deltaSample(model, p, wo, inside, u, wi, weight, continuation);
+  uint s = effectiveSampler(strategy, quadSet);
+  vec3 f;
+  if (!strategySample(s, model, quadSet, p, wo, u, rngKey, wi, pdf, f)) return false;
+  weight = f * (wi.z / pdf);
+#if NUSSELT_WITH_QUADTREE
+  // The random-walk source's roulette: continue with the tabulated directional albedo. With
+  // sampling proportional to f cos the weight's luminance is that albedo, so surviving paths of
+  // a grey BRDF carry weight 1.
+  if (s == SAMPLER_QUADTREE) {
+    continuation = min(1.0f, quadAlbedo(quadSet, wo.z, portableAtan2(wo.y, wo.x)));
+    return true;
+  }
+#endif
+  float cont = -1.0f;  // < 0: min(1, luminance(weight))
+#if defined(NUSSELT_HAS_TABULATED) && NUSSELT_WITH_TABULATED
+  if (s == SAMPLER_TABULATED) {
+    float a = tabAlbedo(quadSet, wo);
+    if (a > 0.0f) cont = min(1.0f, a);
+  }
+#endif
+  // Without a tabulated albedo, the sample weight's luminance (its estimate) is the continuation.
+  continuation = cont >= 0.0f ? cont : min(1.0f, luminance(weight));
+  return true;
 }
 
 // The throughput roulette (ROULETTE_THROUGHPUT): from bounce ROULETTE_MIN_BOUNCE on, the walk goes on

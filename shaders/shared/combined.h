@@ -64,8 +64,7 @@ SHARED_FN float componentTableAlbedo(vec4 lo, vec4 hi, float c) {
 SHARED_FN float componentChoiceAlbedo(uint strategy, uint model, GpuComponent C, vec3 wo) {
   float w = C.data.x;
   if (!(w > 0.0f) || wo.z <= 0.0f) return 0.0f;
-  if (model == MODEL_MIRROR) return w * luminance(mirrorReflectance(C.params, wo.z));
-  if (model == MODEL_DIELECTRIC) return w;  // lossless: reflection + transmission carry all
+  if (modelIsDelta(model)) return w * deltaChoiceAlbedo(model, C.params, wo, false);
   if (effectiveSampler(strategy, C.info.y) == SAMPLER_QUADTREE)
     return w * quadAlbedo(C.info.y, wo.z, portableAtan2(wo.y, wo.x));
   return w * componentTableAlbedo(C.albedoLo, C.albedoHi, wo.z);
@@ -77,8 +76,7 @@ SHARED_FN float componentChoiceAlbedo(uint strategy, uint model, GpuComponent C,
 SHARED_FN float componentChoiceMaxAlbedo(uint model, GpuComponent C, vec3 wo) {
   float w = C.data.x;
   if (!(w > 0.0f) || wo.z <= 0.0f) return 0.0f;
-  if (model == MODEL_MIRROR) return w * maxComponent(mirrorReflectance(C.params, wo.z));
-  if (model == MODEL_DIELECTRIC) return w;
+  if (modelIsDelta(model)) return w * deltaChoiceAlbedo(model, C.params, wo, true);
   return w * componentTableAlbedo(C.albedoLo, C.albedoHi, wo.z);
 }
 

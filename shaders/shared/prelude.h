@@ -5,7 +5,7 @@
 //   - write float literals with an f suffix (0.5f): a bare 0.5 is a double in C++;
 //   - no swizzles (v.xy), no recursion, no GLSL built-in block variables;
 //   - out/inout parameters through OUT(T) / INOUT(T);
-//   - functions are declared SHARED_FN (inline in C++, nothing in GLSL);
+//   - functions are declared SHARED_FN (inline in C++, nothing in GLSL), constants SHARED_CONST;
 //   - structs hold only vec4 / uvec4 / float / uint members, so that std430, scalar and
 //     C++ layouts coincide; every struct has a static_assert on its size in C++.
 #ifndef NUSSELT_PRELUDE_H
@@ -29,6 +29,7 @@ using uint = std::uint32_t;
 #define OUT(T) T&
 #define INOUT(T) T&
 #define CONST_ARRAY(T) static constexpr T
+#define SHARED_CONST inline constexpr
 #define STATIC_ASSERT_SIZE(T, n) static_assert(sizeof(T) == (n), #T " layout changed")
 // GLSL built-ins that GLM lacks or names differently.
 SHARED_BEGIN
@@ -44,6 +45,7 @@ SHARED_END
 #define OUT(T) out T
 #define INOUT(T) inout T
 #define CONST_ARRAY(T) const T
+#define SHARED_CONST const
 #define STATIC_ASSERT_SIZE(T, n)
 bool isFinite(float x) { return !isnan(x) && !isinf(x); }
 #endif
@@ -55,6 +57,10 @@ SHARED_BEGIN
 #define NUSSELT_TWO_PI 6.28318530717958647692f
 // The largest float below 1: uniform numbers live in [0, 1) (STYLE.md: never return 1.0).
 #define NUSSELT_ONE_MINUS_EPS 0.99999994f
+
+// Token pasting after expansion of both operands (the model list, brdf/models.h).
+#define NUSSELT_CAT2(a, b) a##b
+#define NUSSELT_CAT(a, b) NUSSELT_CAT2(a, b)
 
 // Rec. 709 / sRGB-primaries luminance: the scalar used for sampling and Russian roulette.
 SHARED_FN float luminance(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }

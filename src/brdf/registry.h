@@ -1,6 +1,7 @@
 // registry.h: the catalogue of reflectance models as the CPU sees it: names, parameters with
 // defaults and ranges, and the packing of parameter values into the shared BrdfParams block.
-// The formulas themselves live only in shaders/shared/brdf/<model>.h.
+// Each model declares its formula and its spec in shaders/shared/brdf/<model>.h (types in
+// model_spec.h); the catalogue is generated from the model list, shaders/shared/brdf/models.h.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -9,66 +10,9 @@
 #include <vector>
 
 #include "../../shaders/shared/brdf/dispatch.h"
+#include "model_spec.h"
 
 namespace nusselt {
-
-using shared::BrdfParams;
-
-// A parameter value as written in a scene or on the command line.
-struct ParamValue {
-  enum class Kind { Number, String, Array } kind = Kind::Number;
-  double number = 0;
-  std::string text;
-  std::vector<ParamValue> items;
-  static ParamValue num(double v) { ParamValue p; p.kind = Kind::Number; p.number = v; return p; }
-  static ParamValue str(std::string v) { ParamValue p; p.kind = Kind::String; p.text = std::move(v); return p; }
-};
-using NamedParams = std::vector<std::pair<std::string, ParamValue>>;
-// An array of numbers (e.g. a lafortune lobe [Cx, Cy, Cz, n]).
-inline ParamValue arrayValue(std::vector<ParamValue> items) {
-  ParamValue p;
-  p.kind = ParamValue::Kind::Array;
-  p.items = std::move(items);
-  return p;
-}
-
-enum class ParamKind {
-  Scalar,  // one float
-  Colour,  // three floats (RGB); a single number is broadcast to all three
-  Choice,  // one of a list of names, stored as its index (a number is accepted too)
-  Lobes,   // lafortune: [[Cx, Cy, Cz, n], ...], up to LAFORTUNE_MAX_LOBES; stored as the count at
-           // offset, the lobes from offset + 1 (4 floats each). minValue/maxValue bound Cx, Cy, Cz;
-           // n must lie in (0, lobeMaxExponent].
-};
-
-struct ParamSpec {
-  std::string name;
-  ParamKind kind = ParamKind::Scalar;
-  std::uint32_t offset = 0;          // first float in BrdfParams
-  float defaultValue[3] = {0, 0, 0};
-  float minValue = 0;                // inclusive
-  float maxValue = 0;                // inclusive
-  bool minExclusive = false;         // (0, 1] style ranges
-  std::vector<std::string> choices;  // Choice only
-  std::vector<float> defaultLobes;   // Lobes only: 4 floats per lobe
-  float lobeMaxExponent = 0;         // Lobes only
-  std::string doc;
-};
-
-struct ModelSpec {
-  std::string name;
-  std::uint32_t id = 0;  // MODEL_* in shaders/shared/brdf/dispatch.h
-  bool delta = false;    // mirror, dielectric: never evaluated or light-sampled
-  bool measured = false; // merl: a table read from a file (loadMerl, src/brdf/merl.h), no parameters
-  std::vector<ParamSpec> params;
-  std::string summary;
-  // The catalogue's parameter sets (docs/brdf-models.md): typical (= the defaults) and hard
-  // (numerically hardest), plus named variants (e.g. ward's other normalisations).
-  NamedParams typical;
-  NamedParams hard;
-  std::vector<std::pair<std::string, NamedParams>> variants;
-};
-
 
 // The analytic catalogue (the 20 models of docs/models.md).
 const std::vector<ModelSpec>& allModels();

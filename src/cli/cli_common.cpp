@@ -1,4 +1,5 @@
 #include "cli/cli_common.h"
+#include "scene/default_scene.h"
 
 #include <cstdio>
 
@@ -21,9 +22,6 @@
 #include "util/error.h"
 
 namespace nusselt {
-extern const unsigned char kDefaultSceneBytes[];
-extern const std::size_t kDefaultSceneSize;
-
 bool validationFromEnvironment() {
   const char* v = std::getenv("NUSSELT_VALIDATION");
   return v && *v && std::string(v) != "0";
@@ -43,7 +41,7 @@ void checkOutputPath(const std::string& path, const std::string& option) {
 Scene loadSceneOrDefault(const std::string& path, const std::string& camera) {
   LoadOptions opts;
   opts.cameraName = camera;
-  if (path.empty()) return loadSceneFromMemory(kDefaultSceneBytes, kDefaultSceneSize, "default scene (cornell-box.glb)", opts);
+  if (path.empty()) return loadDefaultScene(opts);
   return loadScene(path, opts);
 }
 

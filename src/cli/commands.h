@@ -18,7 +18,7 @@ using CommandRunner = std::function<int()>;
 void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run);
 // `nusselt bench error` (src/cli/bench_error.cpp); registered by registerSamplerCommands.
 void registerBenchError(CLI::App& bench, CommandRunner& run);
-// `nusselt preview` (src/render/preview.cpp).
+// `nusselt preview` (src/cli/preview.cpp).
 void registerPreviewCommand(CLI::App& app, CommandRunner& run);
 
 }  // namespace nusselt

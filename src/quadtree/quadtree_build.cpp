@@ -15,6 +15,7 @@
 #include "quadtree/quadtree_build.h"
 
 #include "brdf/merl.h"
+#include "brdf/registry.h"
 
 #include <algorithm>
 #include <array>
@@ -28,38 +29,8 @@ namespace nusselt::quadtree {
 using namespace shared;
 
 ModelTraits modelTraits(std::uint32_t model, const BrdfParams& p) {
-  ModelTraits t;
-  switch (model) {
-    case MODEL_WARD: {
-      std::uint32_t norm = std::uint32_t(brdfParam(p, WARD_NORMALIZATION) + 0.5f);
-      t.rimExponent = norm == WARD_NORM_WARD92 ? 0.5f : (norm == WARD_NORM_DUER ? 1.0f : 0.0f);
-      t.anisotropic = brdfParam(p, WARD_AX) != brdfParam(p, WARD_AY);
-      break;
-    }
-    case MODEL_MINNAERT: t.rimExponent = std::max(0.0f, 1.0f - brdfParam(p, MINNAERT_K)); break;
-    case MODEL_SCHLICK:
-      t.rimExponent = brdfParam(p, SCHLICK_MULTIPLE) > 0.5f ? 1.0f : 0.0f;
-      t.anisotropic = brdfParam(p, SCHLICK_P) < 1.0f;
-      break;
-    case MODEL_BEARD_MAXWELL: t.rimExponent = 1.0f; break;
-    // strauss' specular term carries 1 / cos(theta_i) of the SAMPLED direction (it is not
-    // reciprocal): f(., v) ~ 1 / cos at the rim wherever the lobe reaches it.
-    case MODEL_STRAUSS: t.rimExponent = 1.0f; break;
-    case MODEL_ASHIKHMIN_SHIRLEY:
-      t.anisotropic = brdfParam(p, ASHIKHMIN_SHIRLEY_NU) != brdfParam(p, ASHIKHMIN_SHIRLEY_NV);
-      break;
-    case MODEL_LAFORTUNE: {
-      std::uint32_t count = std::uint32_t(brdfParam(p, LAFORTUNE_LOBE_COUNT) + 0.5f);
-      for (std::uint32_t j = 0; j < count; ++j) {
-        std::uint32_t o = LAFORTUNE_LOBES + 4 * j;
-        if (brdfParam(p, o) != brdfParam(p, o + 1)) t.anisotropic = true;
-      }
-      break;
-    }
-    case MODEL_POULIN_FOURNIER: t.anisotropic = true; break;
-    default: break;
-  }
-  return t;
+  const ModelSpec& spec = modelById(model);
+  return spec.traits ? spec.traits(p) : ModelTraits{};
 }
 
 namespace {
@@ -517,26 +488,13 @@ void Builder::collectPeaks() {
   } else {
     for (int k = 0; k < 8; ++k) m_peaks.push_back({std::cos(k * M_PI / 4), std::sin(k * M_PI / 4)});
   }
-  if (m_model == MODEL_LAFORTUNE) {
-    std::uint32_t count = std::uint32_t(brdfParam(m_params, LAFORTUNE_LOBE_COUNT) + 0.5f);
-    for (std::uint32_t j = 0; j < count && j < LAFORTUNE_MAX_LOBES; ++j) {
-      std::uint32_t o = LAFORTUNE_LOBES + 4 * j;
-      double ax = brdfParam(m_params, o) * m_v.x, ay = brdfParam(m_params, o + 1) * m_v.y,
-             az = brdfParam(m_params, o + 2) * m_v.z;
-      double n = std::sqrt(ax * ax + ay * ay + az * az);
-      if (n <= 0) continue;
-      double hr = std::sqrt(ax * ax + ay * ay);
-      if (az > 0) m_peaks.push_back({ax / n, ay / n});
-      else if (hr > 0) m_peaks.push_back({ax / hr, ay / hr});
-    }
-  }
-  if (m_model == MODEL_POULIN_FOURNIER) m_ridges.push_back({0, -vx});  // reflection cone of the cylinder axis (x)
-  // Anisotropic half-vector models (ward, ashikhmin_shirley, schlick with p < 1) with one
-  // roughness far below the other: f streaks along h.x = 0 and h.y = 0, the lines w.x = -v.x
-  // and w.y = -v.y through the mirror direction, as thin as the small roughness (ward's hard
-  // set: 0.01). A rim cell crossed by such a streak between its Gauss points would lose the
-  // streak's mass (measured: 9 % of the albedo of ward's hard set at theta 40, phi 67.5).
-  else if (m_traits.anisotropic) {
+  // The model's own features (shaders/shared/brdf/<model>.h): extra peaks, and ridges that
+  // replace the default ones below.
+  ModelFeatures features;
+  if (const auto hook = modelById(m_model).features) hook(m_params, m_v, features);
+  m_peaks.insert(m_peaks.end(), features.peaks.begin(), features.peaks.end());
+  for (const DiscRidge& r : features.ridges) m_ridges.push_back({r.axis, r.value});
+  if (features.ridges.empty() && m_traits.anisotropic) {
     m_ridges.push_back({0, -vx});
     m_ridges.push_back({1, -vy});
   }

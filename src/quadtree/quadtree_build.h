@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "../../shaders/shared/quadtree.h"
+#include "../brdf/model_spec.h"
 
 namespace nusselt::quadtree {
 
@@ -20,12 +21,9 @@ struct BuildSettings {
   double tailTol = 1e-7;        // cells with mass <= tailTol a become leaves whatever their acceptance
 };
 
-// What the model needs from the builder: the rim exponent s (f ~ cos^-s at the horizon; 0 when
-// f is bounded on the disc) and whether it depends on the azimuth of v.
-struct ModelTraits {
-  float rimExponent = 0.0f;
-  bool anisotropic = false;
-};
+// What the model needs from the builder (rim exponent, anisotropy): declared by each model in
+// its header (ModelSpec::traits, src/brdf/model_spec.h); defaults when it declares none.
+using ModelTraits = ::nusselt::ModelTraits;
 ModelTraits modelTraits(std::uint32_t model, const shared::BrdfParams& params);
 
 struct TreeStats {

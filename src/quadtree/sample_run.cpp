@@ -78,24 +78,9 @@ SampleBatch sampleCpuStrategy(std::uint32_t strategy, const sampling::TabulatedT
     if (tab) scope = std::make_unique<sampling::TabHostScope>(*tab);
     for (std::uint32_t i = t; i < n; i += nt) {
       vec2 u = rng2(i, 0u, RNG_DIM_BSDF, seed);
-      vec3 w(0.0f);
-      float pdf = 0.0f;
-      bool ok = false;
-      if (strategy == SAMPLER_ANALYTIC) {
-        ok = analyticSample(model, params, v, u, w, pdf);
-      } else if (strategy == SAMPLER_TABULATED) {
-        ok = tabSample(set, v, u, w, pdf);
-      } else if (strategy == SAMPLER_UNIFORM) {
-        float r = cosFromSin(u.x), phi = NUSSELT_TWO_PI * u.y;
-        w = vec3(r * std::cos(phi), r * std::sin(phi), u.x);
-        pdf = 0.5f * NUSSELT_INV_PI;
-        ok = w.z > 0.0f;
-      } else {
-        w = squareToCosineHemisphere(u);
-        pdf = cosineHemispherePdf(w);
-        ok = w.z > 0.0f && pdf > 0.0f;
-      }
-      vec3 f = ok ? brdfEval(model, params, w, v) : vec3(0.0f);
+      vec3 w, f;
+      float pdf;
+      bool ok = strategySample(strategy, model, set, params, v, u, uvec4(i, 0u, RNG_DIM_BSDF, seed), w, pdf, f);
       out.wPdf[i] = vec4(w, ok ? pdf : 0.0f);
       out.fOk[i] = vec4(f, ok ? 1.0f : 0.0f);
     }

@@ -1,6 +1,6 @@
 // test_environment_gpu.cpp: CPU/GPU parity of the environment's shared functions (envmap.h,
 // distribution2d.h): the same map, uniform pairs and directions through the C++ build and through
-// the GLSL build on the device (shaders/stages/env_tool.comp).
+// the GLSL build on the device (shaders/tools/env_tool.comp).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -43,4 +43,40 @@ SHARED_FN vec3 beardMaxwellEval(BrdfParams p, vec3 wi, vec3 wo) {
 }
 
 SHARED_END
+
+// ---- Traits read by the model list (models.h) ----
+// BEARD_MAXWELL_DELTA: 0 (evaluated and light-sampled).
+// BEARD_MAXWELL_ANALYTIC: 0: the analytic strategy samples the cosine.
+#define BEARD_MAXWELL_DELTA 0
+#define BEARD_MAXWELL_ANALYTIC 0
+
+#ifdef __cplusplus
+#include "../../../src/brdf/model_spec.h"
+namespace nusselt::models {
+inline ModelTraits beardMaxwellTraits(const BrdfParams&) {
+  ModelTraits t;
+  t.rimExponent = 1.0f;
+  return t;
+}
+inline void beardMaxwellSpec(ModelSpec& m) {
+  using namespace spec;
+  m.name = "beard_maxwell";
+  m.summary = "Beard-Maxwell (NEF form): paint first surface + volumetric terms";
+  m.params.push_back(scalar("n", BEARD_MAXWELL_N, 1.5f, 0.0f, 10.0f, true, "real part of the surface index"));
+  m.params.push_back(scalar("k", BEARD_MAXWELL_K, 0.0f, 0.0f, 20.0f, false, "extinction coefficient"));
+  m.params.push_back(scalar("B", BEARD_MAXWELL_B, 0.5f, 0.0f, 1000.0f, false, "first-surface lobe amplitude [1/sr]"));
+  m.params.push_back(scalar("sigma", BEARD_MAXWELL_SIGMA, 0.1f, 0.001f, 1.5f, false, "facet tilt width [rad]"));
+  m.params.push_back(scalar("tau_deg", BEARD_MAXWELL_TAU_DEG, 20.0f, 0.0f, 180.0f, true, "shadowing constant [deg]"));
+  m.params.push_back(scalar("omega_deg", BEARD_MAXWELL_OMEGA_DEG, 50.0f, 0.0f, 1000.0f, true, "obscuration constant [deg]"));
+  m.params.push_back(colour("rho_d", BEARD_MAXWELL_RHO_D, 0.05f, 0.0f, 1.0f, "volumetric Lambertian BRDF value [1/sr]"));
+  m.params.push_back(colour("rho_v", BEARD_MAXWELL_RHO_V, 0.05f, 0.0f, 1.0f, "directional-volumetric coefficient"));
+  m.typical = {N("n", 1.5), N("k", 0), N("B", 0.5), N("sigma", 0.1), N("tau_deg", 20), N("omega_deg", 50),
+               N("rho_d", 0.05), N("rho_v", 0.05)};
+  m.hard = {N("n", 1.5), N("k", 0), N("B", 10), N("sigma", 0.02), N("tau_deg", 5), N("omega_deg", 5),
+            N("rho_d", 0), N("rho_v", 0.1)};
+  m.traits = &beardMaxwellTraits;
+}
+}  // namespace nusselt::models
+#endif
+
 #endif

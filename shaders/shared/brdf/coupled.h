@@ -64,4 +64,32 @@ SHARED_FN vec3 coupledEval(BrdfParams p, vec3 wi, vec3 wo) {
 }
 
 SHARED_END
+
+// ---- Traits read by the model list (models.h) ----
+// COUPLED_DELTA: 0 (evaluated and light-sampled).
+// COUPLED_ANALYTIC: 0: the analytic strategy samples the cosine.
+#define COUPLED_DELTA 0
+#define COUPLED_ANALYTIC 0
+
+#ifdef __cplusplus
+#include "../../../src/brdf/model_spec.h"
+namespace nusselt {
+void fillCoupledTables(shared::BrdfParams& params);  // src/brdf/albedo.cpp: the specular albedo tables
+}  // namespace nusselt
+namespace nusselt::models {
+inline void coupledSpec(ModelSpec& m) {
+  using namespace spec;
+  m.name = "coupled";
+  m.summary = "Kelemen & Szirmay-Kalos 2001 coupled specular-matte";
+  m.params.push_back(colour("rd", COUPLED_RD, 0.6f, 0.0f, 1.0f, "matte albedo"));
+  m.params.push_back(colour("f0", COUPLED_F0, 0.05f, 0.0f, 1.0f, "Fresnel reflectance at normal incidence"));
+  m.params.push_back(scalar("m", COUPLED_M, 0.2f, 0.01f, 1.0f, false,
+                            "Beckmann rms slope (>= 0.01: the specular albedo table is computed at load)"));
+  m.typical = {N("rd", 0.6), N("f0", 0.05), N("m", 0.2)};
+  m.hard = {N("rd", 0.9), N("f0", 0.9), N("m", 0.02)};
+  m.finishParams = &fillCoupledTables;
+}
+}  // namespace nusselt::models
+#endif
+
 #endif

@@ -42,5 +42,63 @@ SHARED_FN bool dielectricRefract(float eta, vec3 w, OUT(vec3) t) {
   return true;
 }
 
+// ---- Delta sampling (dispatch.h) ----
+// Reflect with probability R (Fresnel), refract otherwise: weight 1 for either, times the
+// radiance scaling (n_wo / n_wi)^2 across the interface for refraction (catalogue 2.19). inside:
+// the path arrived from the inside, where the relative index is 1/eta.
+SHARED_FN bool dielectricDeltaSample(BrdfParams p, vec3 wo, bool inside, vec2 u, OUT(vec3) wi, OUT(vec3) weight,
+                                     OUT(float) continuation) {
+  float eta = brdfParam(p, DIELECTRIC_ETA);
+  float etaRel = inside ? 1.0f / eta : eta;  // n(wi side) / n(wo side) for transmission
+  float R = fresnelDielectric(wo.z, etaRel);
+  vec3 t;
+  if (u.x < R || !dielectricRefract(etaRel, wo, t)) {
+    wi = brdfReflectZ(wo);
+    weight = vec3(1.0f);
+  } else {
+    wi = t;
+    weight = vec3(1.0f / (etaRel * etaRel));
+  }
+  // The walk does not end at a lossless interface: the radiance scaling is not an albedo.
+  continuation = 1.0f;
+  return true;
+}
+
+// Lossless: reflection and transmission together carry everything.
+SHARED_FN float dielectricDeltaChoiceAlbedo(BrdfParams p, vec3 wo, bool largestChannel) {
+  BRDF_UNUSED(p);
+  BRDF_UNUSED(wo);
+  BRDF_UNUSED(largestChannel);
+  return 1.0f;
+}
+
+// (n_wi / n_wo)^2 of a refracted sample.
+SHARED_FN float dielectricTransmissionEtaScale(BrdfParams p, bool inside) {
+  float eta = brdfParam(p, DIELECTRIC_ETA);
+  float etaRel = inside ? 1.0f / eta : eta;
+  return etaRel * etaRel;
+}
+
 SHARED_END
+
+// ---- Traits read by the model list (models.h) ----
+// DIELECTRIC_DELTA: 1, a delta model: never evaluated or light-sampled; sampled by dielectricDeltaSample.
+// DIELECTRIC_ANALYTIC: 0: the analytic strategy samples the cosine.
+#define DIELECTRIC_DELTA 1
+#define DIELECTRIC_ANALYTIC 0
+
+#ifdef __cplusplus
+#include "../../../src/brdf/model_spec.h"
+namespace nusselt::models {
+inline void dielectricSpec(ModelSpec& m) {
+  using namespace spec;
+  m.name = "dielectric";
+  m.summary = "ideal refraction with Fresnel and total internal reflection (delta)";
+  m.params.push_back(scalar("eta", DIELECTRIC_ETA, 1.5f, 0.1f, 10.0f, false, "n_inside / n_outside"));
+  m.typical = {N("eta", 1.5)};
+  m.hard = {N("eta", 2.42)};
+}
+}  // namespace nusselt::models
+#endif
+
 #endif

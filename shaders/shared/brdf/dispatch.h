@@ -1,88 +1,80 @@
-// dispatch.h: model ids and the one switch that maps a model id to its shared definition.
-// In a shade stage the model id is a specialization constant, so the switch folds to the one
-// model that stage serves (lavapipe runs every reachable branch body: see README "Design").
+// dispatch.h: the switches that map a model id to its shared definition, generated from the
+// model list (models.h). In a shade stage the model id is a specialization constant, so each
+// switch folds to the one model that stage serves (lavapipe runs every reachable branch body:
+// see README "Design").
 #ifndef NUSSELT_BRDF_DISPATCH_H
 #define NUSSELT_BRDF_DISPATCH_H
 #include "../layout.h"
-#include "lambert.h"
-#include "phong_specular.h"
-#include "phong.h"
-#include "lewis.h"
-#include "blinn.h"
-#include "torrance_sparrow.h"
-#include "ward.h"
-#include "ashikhmin_shirley.h"
-#include "lafortune.h"
-#include "minnaert.h"
-#include "oren_nayar.h"
-#include "schlick.h"
-#include "strauss.h"
-#include "beard_maxwell.h"
-#include "htsg.h"
-#include "poulin_fournier.h"
-#include "coupled.h"
-#include "mirror.h"
-#include "dielectric.h"
-#include "gltf_pbr.h"
-#include "merl.h"
+#include "models.h"
 SHARED_BEGIN
 
-// Model ids: stable numbers, also written into cache keys and EXR headers.
-#define MODEL_LAMBERT 0u
-#define MODEL_PHONG_SPECULAR 1u
-#define MODEL_PHONG 2u
-#define MODEL_LEWIS 3u
-#define MODEL_BLINN 4u
-#define MODEL_TORRANCE_SPARROW 5u
-#define MODEL_WARD 6u
-#define MODEL_ASHIKHMIN_SHIRLEY 7u
-#define MODEL_LAFORTUNE 8u
-#define MODEL_MINNAERT 9u
-#define MODEL_OREN_NAYAR 10u
-#define MODEL_SCHLICK 11u
-#define MODEL_STRAUSS 12u
-#define MODEL_BEARD_MAXWELL 13u
-#define MODEL_HTSG 14u
-#define MODEL_POULIN_FOURNIER 15u
-#define MODEL_COUPLED 16u
-#define MODEL_MIRROR 17u
-#define MODEL_DIELECTRIC 18u
-#define MODEL_GLTF_PBR 19u
-#define MODEL_MERL 20u  // measured (a table per material: docs/measured.md)
-#define MODEL_COUNT 21u
-
-// Delta models (mirror, dielectric) are never evaluated or light-sampled: sample them
-// analytically (mirrorReflectance, dielectricReflectance / dielectricRefract).
-SHARED_FN bool modelIsDelta(uint model) { return model == MODEL_MIRROR || model == MODEL_DIELECTRIC; }
+// Delta models (<NAME>_DELTA 1: mirror, dielectric) are never evaluated or light-sampled: they
+// are sampled by deltaSample below.
+SHARED_FN bool modelIsDelta(uint model) {
+#define NUSSELT_DELTA_CASE_1(NAME, fn) case MODEL_##NAME: return true;
+#define NUSSELT_DELTA_CASE_0(NAME, fn)
+#define NUSSELT_DELTA_CASE(id, NAME, fn) NUSSELT_CAT(NUSSELT_DELTA_CASE_, NAME##_DELTA)(NAME, fn)
+  switch (model) {
+    NUSSELT_MODELS(NUSSELT_DELTA_CASE)
+    default: break;
+  }
+  return false;
+}
 
 // BRDF value f(wi, wo) [1/sr] in the local frame (normal +z); wi towards the light, wo towards
 // the viewer. Zero for delta models and for directions below the surface.
 SHARED_FN vec3 brdfEval(uint model, BrdfParams p, vec3 wi, vec3 wo) {
+#define NUSSELT_EVAL_CASE(id, NAME, fn) case MODEL_##NAME: return fn##Eval(p, wi, wo);
   switch (model) {
-    case MODEL_LAMBERT: return lambertEval(p, wi, wo);
-    case MODEL_PHONG_SPECULAR: return phongSpecularEval(p, wi, wo);
-    case MODEL_PHONG: return phongEval(p, wi, wo);
-    case MODEL_LEWIS: return lewisEval(p, wi, wo);
-    case MODEL_BLINN: return blinnEval(p, wi, wo);
-    case MODEL_TORRANCE_SPARROW: return torranceSparrowEval(p, wi, wo);
-    case MODEL_WARD: return wardEval(p, wi, wo);
-    case MODEL_ASHIKHMIN_SHIRLEY: return ashikhminShirleyEval(p, wi, wo);
-    case MODEL_LAFORTUNE: return lafortuneEval(p, wi, wo);
-    case MODEL_MINNAERT: return minnaertEval(p, wi, wo);
-    case MODEL_OREN_NAYAR: return orenNayarEval(p, wi, wo);
-    case MODEL_SCHLICK: return schlickEval(p, wi, wo);
-    case MODEL_STRAUSS: return straussEval(p, wi, wo);
-    case MODEL_BEARD_MAXWELL: return beardMaxwellEval(p, wi, wo);
-    case MODEL_HTSG: return htsgEval(p, wi, wo);
-    case MODEL_POULIN_FOURNIER: return poulinFournierEval(p, wi, wo);
-    case MODEL_COUPLED: return coupledEval(p, wi, wo);
-    case MODEL_MIRROR: return mirrorEval(p, wi, wo);
-    case MODEL_DIELECTRIC: return dielectricEval(p, wi, wo);
-    case MODEL_GLTF_PBR: return gltfPbrEval(p, wi, wo);
-    case MODEL_MERL: return merlEval(p, wi, wo);
+    NUSSELT_MODELS(NUSSELT_EVAL_CASE)
     default: break;
   }
   return vec3(0.0f);
+}
+
+// ---- Delta models: each defines (see mirror.h) ----
+//   bool <fn>DeltaSample(p, wo, inside, u, OUT wi, OUT weight, OUT continuation): the sampled
+//     direction, its weight (f cos / pdf) and the source roulette's continuation probability;
+//   float <fn>DeltaChoiceAlbedo(p, wo, largestChannel): the directional albedo a combined
+//     material's component choice uses (luminance, or the largest channel);
+//   float <fn>TransmissionEtaScale(p, inside): (n_wi / n_wo)^2 for a sample that crossed the
+//     surface (the throughput roulette's etaScale), 1 for a model that only reflects.
+#define NUSSELT_DELTA_SAMPLE_1(NAME, fn) \
+  case MODEL_##NAME: return fn##DeltaSample(p, wo, inside, u, wi, weight, continuation);
+#define NUSSELT_DELTA_SAMPLE_0(NAME, fn)
+#define NUSSELT_DELTA_SAMPLE(id, NAME, fn) NUSSELT_CAT(NUSSELT_DELTA_SAMPLE_, NAME##_DELTA)(NAME, fn)
+SHARED_FN bool deltaSample(uint model, BrdfParams p, vec3 wo, bool inside, vec2 u, OUT(vec3) wi, OUT(vec3) weight,
+                           OUT(float) continuation) {
+  switch (model) {
+    NUSSELT_MODELS(NUSSELT_DELTA_SAMPLE)
+    default: break;
+  }
+  return false;
+}
+
+#define NUSSELT_DELTA_ALBEDO_1(NAME, fn) case MODEL_##NAME: return fn##DeltaChoiceAlbedo(p, wo, largestChannel);
+#define NUSSELT_DELTA_ALBEDO_0(NAME, fn)
+#define NUSSELT_DELTA_ALBEDO(id, NAME, fn) NUSSELT_CAT(NUSSELT_DELTA_ALBEDO_, NAME##_DELTA)(NAME, fn)
+SHARED_FN float deltaChoiceAlbedo(uint model, BrdfParams p, vec3 wo, bool largestChannel) {
+  switch (model) {
+    NUSSELT_MODELS(NUSSELT_DELTA_ALBEDO)
+    default: break;
+  }
+  return 0.0f;
+}
+
+#define NUSSELT_ETA_SCALE_1(NAME, fn) case MODEL_##NAME: return fn##TransmissionEtaScale(p, inside);
+#define NUSSELT_ETA_SCALE_0(NAME, fn)
+#define NUSSELT_ETA_SCALE(id, NAME, fn) NUSSELT_CAT(NUSSELT_ETA_SCALE_, NAME##_DELTA)(NAME, fn)
+// The factor by which a refraction's radiance scaling (n_wo / n_wi)^2 is undone for the throughput
+// roulette (pbrt's and Mitsuba's etaScale): (n_wi / n_wo)^2 for a sample of `model` that crossed the
+// surface, 1 for everything else (only delta models transmit).
+SHARED_FN float transmissionEtaScale(uint model, BrdfParams p, bool inside) {
+  switch (model) {
+    NUSSELT_MODELS(NUSSELT_ETA_SCALE)
+    default: break;
+  }
+  return 1.0f;
 }
 
 SHARED_END

@@ -48,4 +48,29 @@ SHARED_FN vec3 gltfPbrEval(BrdfParams p, vec3 wi, vec3 wo) {
 }
 
 SHARED_END
+
+// ---- Traits read by the model list (models.h) ----
+// GLTF_PBR_DELTA: 0 (evaluated and light-sampled).
+// GLTF_PBR_ANALYTIC: 0: the analytic strategy samples the cosine.
+#define GLTF_PBR_DELTA 0
+#define GLTF_PBR_ANALYTIC 0
+
+#ifdef __cplusplus
+#include "../../../src/brdf/model_spec.h"
+namespace nusselt::models {
+inline void gltfPbrSpec(ModelSpec& m) {
+  using namespace spec;
+  m.name = "gltf_pbr";
+  m.summary = "glTF 2.0 metallic-roughness (GGX, height-correlated Smith, Schlick)";
+  m.params.push_back(colour("baseColor", GLTF_PBR_BASE_COLOR, 0.8f, 0.0f, 1.0f, "base colour"));
+  m.params.push_back(scalar("metallic", GLTF_PBR_METALLIC, 0.0f, 0.0f, 1.0f, false, "metalness"));
+  m.params.push_back(scalar("roughness", GLTF_PBR_ROUGHNESS, 0.5f, 0.0f, 1.0f, false,
+                            "perceptual roughness (alpha = roughness^2, clamped to >= 1e-3)"));
+  m.typical = {N("baseColor", 0.8), N("metallic", 0), N("roughness", 0.5)};
+  m.hard = {N("baseColor", 1), N("metallic", 1), N("roughness", 0.05)};
+  m.variants = {{"dielectric_rough", {N("baseColor", 1), N("metallic", 0), N("roughness", 1)}}};
+}
+}  // namespace nusselt::models
+#endif
+
 #endif

@@ -115,4 +115,31 @@ SHARED_FN float htsgSpecularReflectance(BrdfParams p, float ci) {
 }
 
 SHARED_END
+
+// ---- Traits read by the model list (models.h) ----
+// HTSG_DELTA: 0 (evaluated and light-sampled).
+// HTSG_ANALYTIC: 0: the analytic strategy samples the cosine.
+#define HTSG_DELTA 0
+#define HTSG_ANALYTIC 0
+
+#ifdef __cplusplus
+#include "../../../src/brdf/model_spec.h"
+namespace nusselt::models {
+inline void htsgSpec(ModelSpec& m) {
+  using namespace spec;
+  m.name = "htsg";
+  m.summary = "He-Torrance-Sillion-Greenberg 1991 (directional + uniform diffuse; specular spike apart)";
+  m.params.push_back(scalar("sigma0", HTSG_SIGMA0, 0.25f, 0.0f, 5.0f, true, "rms roughness height [um]"));
+  m.params.push_back(scalar("tau", HTSG_TAU, 2.5f, 0.0f, 50.0f, true, "autocorrelation length [um]"));
+  m.params.push_back(scalar("lam", HTSG_LAM, 0.55f, 0.1f, 2.0f, false, "wavelength [um]"));
+  m.params.push_back(scalar("n", HTSG_N, 1.5f, 0.0f, 10.0f, true, "real part of the relative index"));
+  m.params.push_back(scalar("k", HTSG_K, 0.0f, 0.0f, 20.0f, false, "extinction coefficient"));
+  m.params.push_back(colour("rho_ud", HTSG_RHO_UD, 0.1f, 0.0f, 1.0f, "uniform-diffuse albedo"));
+  m.typical = {N("sigma0", 0.25), N("tau", 2.5), N("lam", 0.55), N("n", 1.5), N("k", 0), N("rho_ud", 0.1)};
+  m.hard = {N("sigma0", 0.8), N("tau", 4.0), N("lam", 0.55), N("n", 1.5), N("k", 0), N("rho_ud", 0)};
+  m.variants = {{"smooth", {N("sigma0", 0.04), N("tau", 0.4), N("lam", 0.55), N("n", 1.5), N("k", 0), N("rho_ud", 0)}}};
+}
+}  // namespace nusselt::models
+#endif
+
 #endif

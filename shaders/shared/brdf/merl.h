@@ -93,4 +93,23 @@ SHARED_FN vec3 merlEval(BrdfParams p, vec3 wi, vec3 wo) {
 }
 
 SHARED_END
+
+// ---- Traits read by the model list (models.h) ----
+// MERL_DELTA: 0 (evaluated and light-sampled).
+// MERL_ANALYTIC: 0: the analytic strategy samples the cosine.
+#define MERL_DELTA 0
+#define MERL_ANALYTIC 0
+
+#ifdef __cplusplus
+#include "../../../src/brdf/model_spec.h"
+namespace nusselt::models {
+// Measured: no parameters (the table comes from a file: loadMerl, src/brdf/merl.h).
+inline void merlSpec(ModelSpec& m) {
+  m.name = "merl";
+  m.measured = true;
+  m.summary = "measured isotropic BRDF in the MERL 100 binary layout, trilinearly interpolated (docs/measured.md)";
+}
+}  // namespace nusselt::models
+#endif
+
 #endif

@@ -17,4 +17,32 @@ SHARED_FN vec3 minnaertEval(BrdfParams p, vec3 wi, vec3 wo) {
 }
 
 SHARED_END
+
+// ---- Traits read by the model list (models.h) ----
+// MINNAERT_DELTA: 0 (evaluated and light-sampled).
+// MINNAERT_ANALYTIC: 0: the analytic strategy samples the cosine.
+#define MINNAERT_DELTA 0
+#define MINNAERT_ANALYTIC 0
+
+#ifdef __cplusplus
+#include "../../../src/brdf/model_spec.h"
+namespace nusselt::models {
+inline ModelTraits minnaertTraits(const BrdfParams& p) {
+  ModelTraits t;
+  t.rimExponent = std::max(0.0f, 1.0f - shared::brdfParam(p, MINNAERT_K));
+  return t;
+}
+inline void minnaertSpec(ModelSpec& m) {
+  using namespace spec;
+  m.name = "minnaert";
+  m.summary = "Minnaert 1941: rho (k+1)/(2pi) (ci co)^(k-1)";
+  m.params.push_back(colour("rho", MINNAERT_RHO, 0.8f, 0.0f, 1.0f, "albedo at normal incidence"));
+  m.params.push_back(scalar("k", MINNAERT_K, 0.8f, 0.5f, 2.0f, false, "limb darkening exponent (1: Lambert)"));
+  m.typical = {N("rho", 0.8), N("k", 0.8)};
+  m.hard = {N("rho", 1), N("k", 0.5)};
+  m.traits = &minnaertTraits;
+}
+}  // namespace nusselt::models
+#endif
+
 #endif

@@ -36,4 +36,28 @@ SHARED_FN vec3 orenNayarEval(BrdfParams p, vec3 wi, vec3 wo) {
 }
 
 SHARED_END
+
+// ---- Traits read by the model list (models.h) ----
+// OREN_NAYAR_DELTA: 0 (evaluated and light-sampled).
+// OREN_NAYAR_ANALYTIC: 0: the analytic strategy samples the cosine.
+#define OREN_NAYAR_DELTA 0
+#define OREN_NAYAR_ANALYTIC 0
+
+#ifdef __cplusplus
+#include "../../../src/brdf/model_spec.h"
+namespace nusselt::models {
+inline void orenNayarSpec(ModelSpec& m) {
+  using namespace spec;
+  m.name = "oren_nayar";
+  m.summary = "Oren-Nayar 1994 rough diffuse, full model";
+  m.params.push_back(colour("rho", OREN_NAYAR_RHO, 0.8f, 0.0f, 1.0f, "albedo of the facets"));
+  m.params.push_back(scalar("sigma", OREN_NAYAR_SIGMA, 0.35f, 0.0f, 1.5f, false, "slope angle std. dev. [rad]"));
+  m.params.push_back(choice("interreflection", OREN_NAYAR_INTERREFLECTION, 1, {"off", "on"},
+                            "include the L2 interreflection term (0/off or 1/on)"));
+  m.typical = {N("rho", 0.8), N("sigma", 0.35), N("interreflection", 1)};
+  m.hard = {N("rho", 1), N("sigma", 0.7), N("interreflection", 1)};
+}
+}  // namespace nusselt::models
+#endif
+
 #endif

@@ -112,4 +112,40 @@ SHARED_FN vec3 poulinFournierEval(BrdfParams p, vec3 wi, vec3 wo) {
 }
 
 SHARED_END
+
+// ---- Traits read by the model list (models.h) ----
+// POULIN_FOURNIER_DELTA: 0 (evaluated and light-sampled).
+// POULIN_FOURNIER_ANALYTIC: 0: the analytic strategy samples the cosine.
+#define POULIN_FOURNIER_DELTA 0
+#define POULIN_FOURNIER_ANALYTIC 0
+
+#ifdef __cplusplus
+#include "../../../src/brdf/model_spec.h"
+namespace nusselt::models {
+inline ModelTraits poulinFournierTraits(const BrdfParams&) {
+  ModelTraits t;
+  t.anisotropic = true;
+  return t;
+}
+// The reflection cone of the cylinder axis (x): the line x = -v.x of the disc.
+inline void poulinFournierFeatures(const BrdfParams&, const shared::vec3& v, ModelFeatures& out) {
+  out.ridges.push_back({0, -double(v.x)});
+}
+inline void poulinFournierSpec(ModelSpec& m) {
+  using namespace spec;
+  m.name = "poulin_fournier";
+  m.summary = "Poulin-Fournier 1990 parallel cylinders along x with Phong micro-reflection (re-derived)";
+  m.params.push_back(colour("kd", POULIN_FOURNIER_KD, 0.3f, 0.0f, 1.0f, "local diffuse albedo"));
+  m.params.push_back(colour("ks", POULIN_FOURNIER_KS, 0.6f, 0.0f, 1.0f, "local specular albedo"));
+  m.params.push_back(scalar("n", POULIN_FOURNIER_N, 40.0f, 1.0f, 10000.0f, false, "local Phong exponent"));
+  m.params.push_back(scalar("d", POULIN_FOURNIER_D, 0.5f, 0.0f, 10.0f, false, "flat gap between cylinders (radius 1)"));
+  m.params.push_back(scalar("h", POULIN_FOURNIER_H, 0.0f, -0.5f, 0.0f, false, "height of the cylinder axes above the base"));
+  m.typical = {N("kd", 0.3), N("ks", 0.6), N("n", 40), N("d", 0.5), N("h", 0)};
+  m.hard = {N("kd", 0), N("ks", 1), N("n", 400), N("d", 0), N("h", 0)};
+  m.traits = &poulinFournierTraits;
+  m.features = &poulinFournierFeatures;
+}
+}  // namespace nusselt::models
+#endif
+
 #endif

@@ -42,4 +42,37 @@ SHARED_FN vec3 schlickEval(BrdfParams p, vec3 wi, vec3 wo) {
 }
 
 SHARED_END
+
+// ---- Traits read by the model list (models.h) ----
+// SCHLICK_DELTA: 0 (evaluated and light-sampled).
+// SCHLICK_ANALYTIC: 0: the analytic strategy samples the cosine.
+#define SCHLICK_DELTA 0
+#define SCHLICK_ANALYTIC 0
+
+#ifdef __cplusplus
+#include "../../../src/brdf/model_spec.h"
+namespace nusselt::models {
+inline ModelTraits schlickTraits(const BrdfParams& p) {
+  ModelTraits t;
+  t.rimExponent = shared::brdfParam(p, SCHLICK_MULTIPLE) > 0.5f ? 1.0f : 0.0f;
+  t.anisotropic = shared::brdfParam(p, SCHLICK_P) < 1.0f;
+  return t;
+}
+inline void schlickSpec(ModelSpec& m) {
+  using namespace spec;
+  m.name = "schlick";
+  m.summary = "Schlick 1994 rational BRDF (single material, eq. 30)";
+  m.params.push_back(colour("c", SCHLICK_C, 0.5f, 0.0f, 1.0f, "reflectance at normal incidence"));
+  m.params.push_back(scalar("r", SCHLICK_R, 0.2f, 0.0001f, 1.0f, false, "roughness (0 mirror, 1 diffuse)"));
+  m.params.push_back(scalar("p", SCHLICK_P, 1.0f, 0.001f, 1.0f, false, "isotropy (1 isotropic)"));
+  m.params.push_back(choice("multiple", SCHLICK_MULTIPLE, 1, {"off", "on"},
+                            "include the multiple-reflection term (0/off or 1/on)"));
+  m.typical = {N("c", 0.5), N("r", 0.2), N("p", 1), N("multiple", 1)};
+  m.hard = {N("c", 0.9), N("r", 0.002), N("p", 0.1), N("multiple", 1)};
+  m.variants = {{"typical_single", {N("c", 0.5), N("r", 0.2), N("p", 1), N("multiple", 0)}}};
+  m.traits = &schlickTraits;
+}
+}  // namespace nusselt::models
+#endif
+
 #endif

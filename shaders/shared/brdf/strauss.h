@@ -45,4 +45,36 @@ SHARED_FN vec3 straussEval(BrdfParams p, vec3 wi, vec3 wo) {
 }
 
 SHARED_END
+
+// ---- Traits read by the model list (models.h) ----
+// STRAUSS_DELTA: 0 (evaluated and light-sampled).
+// STRAUSS_ANALYTIC: 0: the analytic strategy samples the cosine.
+#define STRAUSS_DELTA 0
+#define STRAUSS_ANALYTIC 0
+
+#ifdef __cplusplus
+#include "../../../src/brdf/model_spec.h"
+namespace nusselt::models {
+// The specular term carries 1 / cos(theta_i) of the SAMPLED direction (it is not reciprocal):
+// f(., v) ~ 1 / cos at the rim wherever the lobe reaches it.
+inline ModelTraits straussTraits(const BrdfParams&) {
+  ModelTraits t;
+  t.rimExponent = 1.0f;
+  return t;
+}
+inline void straussSpec(ModelSpec& m) {
+  using namespace spec;
+  m.name = "strauss";
+  m.summary = "Strauss 1990 (intensity model converted to a BRDF; not reciprocal)";
+  m.params.push_back(colour("c", STRAUSS_C, 0.8f, 0.0f, 1.0f, "surface colour"));
+  m.params.push_back(scalar("s", STRAUSS_S, 0.6f, 0.0f, 0.99f, false, "smoothness (highlight exponent 3/(1-s))"));
+  m.params.push_back(scalar("m", STRAUSS_M, 0.2f, 0.0f, 1.0f, false, "metalness"));
+  m.params.push_back(scalar("t", STRAUSS_T, 0.0f, 0.0f, 1.0f, false, "transparency"));
+  m.typical = {N("c", 0.8), N("s", 0.6), N("m", 0.2), N("t", 0)};
+  m.hard = {N("c", 0.9), N("s", 0.97), N("m", 1), N("t", 0)};
+  m.traits = &straussTraits;
+}
+}  // namespace nusselt::models
+#endif
+
 #endif

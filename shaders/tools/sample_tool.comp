@@ -26,30 +26,10 @@ void main() {
   vec3 v = pc.v.xyz;
   uint seed = pc.seed;
   vec2 u = rng2(i, 0u, RNG_DIM_BSDF, seed);
-  vec3 w = vec3(0.0f);
-  float pdf = 0.0f;
-  vec3 f = vec3(0.0f);
-  bool ok = false;
-  if (SAMPLER == SAMPLER_QUADTREE) {
-    ok = quadSample(M.info.z, MODEL_ID, M.params, v, u, uvec4(i, 0u, RNG_DIM_BSDF, seed), w, pdf, f);
-  } else {
-    if (SAMPLER == SAMPLER_ANALYTIC) {
-      ok = analyticSample(MODEL_ID, M.params, v, u, w, pdf);
-    } else if (SAMPLER == SAMPLER_TABULATED) {
-      ok = tabSample(M.info.z, v, u, w, pdf);
-    } else if (SAMPLER == SAMPLER_UNIFORM) {
-      float r = cosFromSin(u.x);
-      float phi = NUSSELT_TWO_PI * u.y;
-      w = vec3(r * cos(phi), r * sin(phi), u.x);
-      pdf = 0.5f * NUSSELT_INV_PI;
-      ok = w.z > 0.0f;
-    } else {
-      w = squareToCosineHemisphere(u);
-      pdf = cosineHemispherePdf(w);
-      ok = w.z > 0.0f && pdf > 0.0f;
-    }
-    if (ok) f = brdfEval(MODEL_ID, M.params, w, v);
-  }
+  vec3 w;
+  float pdf;
+  vec3 f;
+  bool ok = strategySample(SAMPLER, MODEL_ID, M.info.z, M.params, v, u, uvec4(i, 0u, RNG_DIM_BSDF, seed), w, pdf, f);
   g.film.v[i] = vec4(w, ok ? pdf : 0.0f);
   g.filmSq.v[i] = vec4(f, ok ? 1.0f : 0.0f);
 }
