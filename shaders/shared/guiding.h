@@ -205,6 +205,7 @@ struct GuideVertex {
   float alpha;
 };
 
+#if NUSSELT_SCENE_FEATURES
 GuideVertex guideVertex(vec3 x) {
   uvec4 info = guideLeafInfo(g.guide.v[0], x);
   GuideVertex v;
@@ -257,6 +258,18 @@ void guideRecordSample(uint path, uint bounce, vec3 wi, float value) {
   R.v[i + 1u] = vec4(wi, value > 0.0f ? value : -1.0f);  // 0 would read as "ended here"
   if (bounce + 1u < n) R.v[i + 2u].w = -1.0f;
 }
+#else
+// A module without guiding (NUSSELT_SCENE_FEATURES 0, stage_common.glsl): empty stand-ins.
+GuideVertex guideVertex(vec3 x) { return GuideVertex(0u, 0.0f); }
+float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) { return pdfBsdf; }
+bool guideSampleLocal(GuideVertex v, float uDescent, uint rngMode, uint pixel, uint sampleIndex, uint bounce, uint seed,
+                      vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
+  wiLocal = vec3(0.0f, 0.0f, 1.0f);
+  return false;
+}
+void guideRecordArrival(uint path, uint bounce, vec3 x) {}
+void guideRecordSample(uint path, uint bounce, vec3 wi, float value) {}
+#endif
 #endif
 
 #endif

@@ -9,6 +9,21 @@
 #extension GL_EXT_ray_query : require
 #endif
 
+// Module variants (CMakeLists.txt): lavapipe inlines every call before it folds specialization
+// constants, so code that a constant switches off still costs pipeline-creation time (bench
+// pipelines: shade pipelines 25-40 % slower with the texture and guiding code present but off).
+// The shade and escape stages are therefore compiled twice: NUSSELT_SCENE_FEATURES 0 (no
+// textures, no guiding: the constants below are plain false and their functions are empty
+// stand-ins) and 1 (module <stage>_f: HAS_TEXTURES and GUIDING are specialization constants);
+// intersect and shadow likewise with NUSSELT_ALPHA (module <stage>_a: alpha coverage). A module
+// that sets neither (the other stages, the tools) gets everything.
+#ifndef NUSSELT_SCENE_FEATURES
+#define NUSSELT_SCENE_FEATURES 1
+#endif
+#ifndef NUSSELT_ALPHA
+#define NUSSELT_ALPHA 1
+#endif
+
 #include "shared/layout.h"
 #include "shared/rng.h"
 #include "shared/warp.h"
@@ -17,7 +32,11 @@
 // ---- Alpha coverage (glTF alphaMode; docs/scenes.md, "Alpha") ---------------------------------
 // The tracing stages of a scene with MASK or BLEND materials test every candidate hit (constant
 // 9, set by the integrator for intersect and shadow only; false elsewhere, the tools included).
+#if NUSSELT_ALPHA
 layout(constant_id = 9) const bool HAS_ALPHA = false;
+#else
+const bool HAS_ALPHA = false;
+#endif
 
 // The texel buffer as a plain reference (the globals block is readonly, and a member of it cannot
 // be passed to a function parameter without that qualifier).
@@ -26,6 +45,7 @@ Uints texelBuffer() {
   return t;
 }
 
+#if NUSSELT_ALPHA
 // One step of a PCG-style integer hash (O'Neill's RXS-M-XS output on an LCG step), mixing in v.
 uint alphaHashStep(uint h, uint v) {
   h = (h ^ v) * 747796405u + 2891336453u;
@@ -53,6 +73,9 @@ bool alphaPasses(uint tri, float b1, float b2, vec3 origin, vec3 dir) {
   h = alphaHashStep(h, floatBitsToUint(dir.z));
   return float(h >> 8u) * (1.0f / 16777216.0f) < alpha;
 }
+#else
+bool alphaPasses(uint tri, float b1, float b2, vec3 origin, vec3 dir) { return true; }
+#endif
 
 #include "shared/trace.glsl"
 #include "shared/envmap.h"
@@ -64,11 +87,16 @@ layout(local_size_x = WORKGROUP_SIZE) in;
 // render builds only what its scene needs (lavapipe's Mesa 22.3 ran every branch body a subgroup
 // reached, taken or not; reference/lavapipe.md). Constant 7: after the shade stages' own 0..6.
 layout(constant_id = 7) const bool HAS_ENVIRONMENT = true;
+#if NUSSELT_SCENE_FEATURES
 // Likewise the texture lookups of a scene without textures (Globals.texturedScene; constant 8).
 layout(constant_id = 8) const bool HAS_TEXTURES = true;
 // Path guiding (issue 16, docs/guiding.md): the shade and escape stages of a guided render only;
 // without it every guiding branch is compiled out, and images are those of an unguided build.
 layout(constant_id = 10) const bool GUIDING = false;
+#else
+const bool HAS_TEXTURES = false;
+const bool GUIDING = false;
+#endif
 
 // ---- Queues ---------------------------------------------------------------------------------
 
@@ -137,9 +165,13 @@ vec4 sceneTexture(uint tex, uint tri, float b1, float b2) {
 // (src/render/device_scene.cpp), so the texture enters as a value at the sampled or hit point and
 // both estimators (light sampling and BSDF sampling, with MIS) stay unbiased.
 vec3 texturedEmission(uint material, vec3 emission, uint tri, float b1, float b2) {
+#if NUSSELT_SCENE_FEATURES
   if (!HAS_TEXTURES || (g.materials.v[material].info.y & MATERIAL_TEXTURED) == 0u) return emission;
   uint tex = g.materialTextures.v[material].maps.z;
   return tex == INVALID_INDEX ? emission : emission * sceneTexture(tex, tri, b1, b2).xyz;
+#else
+  return emission;
+#endif
 }
 
 // ---- Lights ---------------------------------------------------------------------------------

@@ -40,6 +40,7 @@ float componentMisPdf(uint model, GpuComponent C, float c, vec3 wo, vec3 wi) {
 // params: the model's parameters (the material's factors on entry); emission: its emitted
 // radiance. gltf_pbr: baseColor x baseColorTexture.rgb (sRGB decoded), metallic x B and roughness
 // x G of metallicRoughnessTexture; any model: emission x emissiveTexture.rgb (sRGB decoded).
+#if NUSSELT_SCENE_FEATURES
 void evalParams(uint model, uint material, uint tri, float b1, float b2, inout BrdfParams params,
                 inout vec3 emission) {
   GpuMaterialTextures T = g.materialTextures.v[material];
@@ -87,6 +88,12 @@ vec3 normalMapped(uint material, uint tri, float b1, float b2, vec3 ns, vec3 ngF
   n /= nl;
   return dot(n, ngFront) * dot(ns, ngFront) > 0.0f ? n : ns;
 }
+#else
+// A module without textures (NUSSELT_SCENE_FEATURES 0, stage_common.glsl): empty stand-ins.
+void evalParams(uint model, uint material, uint tri, float b1, float b2, inout BrdfParams params,
+                inout vec3 emission) {}
+vec3 normalMapped(uint material, uint tri, float b1, float b2, vec3 ns, vec3 ngFront) { return ns; }
+#endif
 
 void main() {
   uint idx = gl_GlobalInvocationID.x;

@@ -139,16 +139,18 @@ void PathIntegrator::createPipelines() {
   // HAS_ENVIRONMENT and HAS_TEXTURES); the others keep the tracing stages without that code.
   std::vector<std::uint32_t> traceSpec;
   if (m_hasAlpha) traceSpec = {0u, 0u, 0u, 0u, 0u, 0u, 0u, m_hasEscape ? 1u : 0u, m_hasTextures ? 1u : 0u, 1u};
-  m_intersect = vk::createComputePipeline(m_ctx, layout, "intersect" + tracing, traceSpec);
+  // Modules with alpha coverage compiled in are <stage>_a (CMakeLists.txt, stage_common.glsl).
+  const std::string alpha = m_hasAlpha ? "_a" : "";
+  m_intersect = vk::createComputePipeline(m_ctx, layout, "intersect" + tracing + alpha, traceSpec);
   // Constant 10 (stage_common.glsl): GUIDING, in the shade and escape stages of guided renders.
   const std::uint32_t guiding = m_guide ? 1u : 0u;
   if (m_hasEscape) {
     if (m_guide)
-      m_escape = vk::createComputePipeline(m_ctx, layout, "escape",
+      m_escape = vk::createComputePipeline(m_ctx, layout, "escape_f",
                                            {0, 0, 0, 0, 0, 0, 0, 1u, m_hasTextures ? 1u : 0u, 0u, guiding});
     else m_escape = vk::createComputePipeline(m_ctx, layout, "escape");
   }
-  m_shadow = vk::createComputePipeline(m_ctx, layout, "shadow" + tracing, traceSpec);
+  m_shadow = vk::createComputePipeline(m_ctx, layout, "shadow" + tracing + alpha, traceSpec);
   m_accumulate = vk::createComputePipeline(m_ctx, layout, "accumulate");
   // Only the models (and combinations) this scene uses: one specialised shade pipeline each,
   // created on all cores (drivers compile at creation; lavapipe takes ~0.3 s per shade pipeline,
@@ -179,8 +181,10 @@ void PathIntegrator::createPipelines() {
             spec.push_back(0u);       // constant 9: HAS_ALPHA (tracing stages only)
             spec.push_back(guiding);  // constant 10: GUIDING
           }
-          // One module per strategy (CMakeLists.txt): shade_sN / shade_combined_sN.
-          const std::string module = std::string(key[0] > 0 ? "shade_combined" : "shade") + "_s" + std::to_string(sampler);
+          // One module per strategy (CMakeLists.txt): shade_sN / shade_combined_sN, and _f with the
+          // texture and guiding code for the scenes and renders that use them.
+          const std::string module = std::string(key[0] > 0 ? "shade_combined" : "shade") + "_s" + std::to_string(sampler) +
+                                     (m_hasTextures || guiding ? "_f" : "");
           m_shade[s] = vk::createComputePipeline(m_ctx, layout, module, spec);
         } catch (const std::exception& e) {
           errors[s] = e.what();

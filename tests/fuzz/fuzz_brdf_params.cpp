@@ -132,7 +132,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     nusselt::NamedParams params;
     if (!parseInput(text, &modelName, &params)) return 0;
     const nusselt::ModelSpec* spec = nusselt::findModel(modelName);
-    if (!spec || (spec->id == MODEL_COUPLED && !coupled) || skipped(spec->name)) return 0;
+    if (!spec || (spec->id == nusselt::MODEL_COUPLED && !coupled) || skipped(spec->name)) return 0;
     for (const nusselt::ParamSpec& ps : spec->params) (void)nusselt::describeRange(ps);
     nusselt::BrdfParams packed = nusselt::packParams(*spec, params, "fuzz");
     for (int i = 0; i < BRDF_PARAM_VEC4S; ++i)
