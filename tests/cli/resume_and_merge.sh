@@ -93,7 +93,12 @@ if NUSSELT_FAULT_DEVICE_LOST_AFTER=1500 "$nusselt" render "${common[@]}" --spp 3
   fail "device loss not reported"
 else
   k=$("$nusselt" info "$work/lost.exr" 2>/dev/null | sed -n 's/^  nusselt\/spp: //p')
-  if grep -q "VK_ERROR_DEVICE_LOST" "$work/err" && grep -q -- "--resume" "$work/err" && [ -n "$k" ] && [ "$k" -le 1500 ]; then
+  # The loss strikes at the first pass boundary at or past 1500 spp (a pass holds several
+  # samples), so the checkpoint may lie past 1500 too, never past the loss.
+  lostat=$(sed -n 's/.*device was lost .* after \([0-9]*\) spp.*/\1/p' "$work/err")
+  named=$(sed -n 's/.*last checkpoint (\([0-9]*\) spp).*/\1/p' "$work/err")
+  if grep -q "VK_ERROR_DEVICE_LOST" "$work/err" && grep -q -- "--resume" "$work/err" && [ -n "$k" ] &&
+    [ -n "$lostat" ] && [ "$lostat" -ge 1500 ] && [ "$k" -ge 1 ] && [ "$k" -le "$lostat" ] && [ "$named" = "$k" ]; then
     echo "ok   device lost: $(cat "$work/err")"
     "$nusselt" render "${common[@]}" --spp 1600 --resume "$work/lost.exr" || fail "resume after device loss"
   else
