@@ -343,13 +343,8 @@ struct SceneCase {
   std::string note;
 };
 
-MaterialComponent componentOf(const std::string& model, float weight, const NamedParams* params = nullptr) {
-  const ModelSpec* m = findModel(model);
-  MaterialComponent c;
-  c.model = m->id;
-  c.weight = weight;
-  c.params = packParams(*m, params ? *params : typicalParams(*m), model);
-  return c;
+MaterialComponent componentOf(const std::string& model, float weight) {
+  return catalogueComponent(model, typicalParams(*findModel(model)), weight);
 }
 
 std::vector<SceneCase> makeScenes(bool quick) {
@@ -365,9 +360,7 @@ std::vector<SceneCase> makeScenes(bool quick) {
     NamedParams rho = typicalParams(*findModel("lambert"));
     MaterialComponent l = componentOf("lambert", 0.6f), ph = componentOf("phong", 0.4f);
     l.params = white.params;  // keep the white albedo
-    white.components = {l, ph};
-    white.model = l.model;
-    white.params = l.params;
+    setComponents(white, {l, ph});
     out.push_back(std::move(c));
   }
   if (!quick && std::filesystem::exists(dir + "/materials/materials.gltf"))

@@ -1,7 +1,9 @@
-// scene.cpp: the default view for scenes without a camera.
+// scene.cpp: the default view for scenes without a camera; materials built in code.
 #include "scene/scene.h"
 
 #include <cmath>
+
+#include "util/error.h"
 
 namespace nusselt {
 
@@ -33,6 +35,41 @@ Camera frameScene(const Scene& scene) {
   if (!std::isfinite(camera.position.x) || !std::isfinite(camera.position.y) || !std::isfinite(camera.position.z))
     camera.position = glm::vec3(0.0f, 0.0f, float(1.0 / std::sin(0.5 * static_cast<double>(camera.yfov))));
   return camera;
+}
+
+namespace {
+const ModelSpec& catalogueModel(const std::string& model, const std::string& name) {
+  const ModelSpec* spec = findModel(model);
+  if (!spec) throw Error(name + ": unknown model \"" + model + "\"");
+  return *spec;
+}
+}  // namespace
+
+Material catalogueMaterial(const std::string& model, const NamedParams& params, const std::string& name,
+                           glm::vec3 emission) {
+  const ModelSpec& spec = catalogueModel(model, name);
+  Material m;
+  m.name = name;
+  m.model = spec.id;
+  m.params = packParams(spec, params, name);
+  m.emission = emission;
+  return m;
+}
+
+MaterialComponent catalogueComponent(const std::string& model, const NamedParams& params, float weight) {
+  const ModelSpec& spec = catalogueModel(model, model);
+  MaterialComponent c;
+  c.model = spec.id;
+  c.weight = weight;
+  c.params = packParams(spec, params, model);
+  return c;
+}
+
+void setComponents(Material& m, const std::vector<MaterialComponent>& components) {
+  if (components.empty()) throw Error(m.name + ": a combined material needs at least one component");
+  m.components = components;
+  m.model = components[0].model;
+  m.params = components[0].params;
 }
 
 }  // namespace nusselt

@@ -181,4 +181,14 @@ struct Scene {
 // framing it with a 45-degree vertical field of view.
 Camera frameScene(const Scene& scene);
 
+// ---- Materials of catalogue models, built in code (tests, benchmarks) ----
+// A material of one model: its parameters packed by packParams (those not given take the model's
+// defaults). Throws nusselt::Error naming `name` for an unknown model or a bad parameter.
+Material catalogueMaterial(const std::string& model, const NamedParams& params, const std::string& name,
+                           glm::vec3 emission = glm::vec3(0.0f));
+// A term w * f of a combined material (errors name the model).
+MaterialComponent catalogueComponent(const std::string& model, const NamedParams& params, float weight = 1.0f);
+// Makes m the combination of `components` (model and params repeat the first, as Material says).
+void setComponents(Material& m, const std::vector<MaterialComponent>& components);
+
 }  // namespace nusselt

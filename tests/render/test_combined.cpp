@@ -20,11 +20,7 @@ using namespace nusselt;
 namespace {
 
 MaterialComponent component(const std::string& model, const NamedParams& params, float weight = 1.0f) {
-  MaterialComponent c;
-  c.model = findModel(model)->id;
-  c.weight = weight;
-  c.params = packParams(*findModel(model), params, model);
-  return c;
+  return catalogueComponent(model, params, weight);
 }
 
 ParamValue rgb(double r, double g, double b) {
@@ -38,9 +34,7 @@ ParamValue rgb(double r, double g, double b) {
 Scene furnace(const std::vector<MaterialComponent>& components) {
   Scene scene = test::loadTestScene("scenes/tests/furnace.gltf");
   EXPECT_EQ(scene.materials.size(), 1u);
-  scene.materials[0].components = components;
-  scene.materials[0].model = components[0].model;
-  scene.materials[0].params = components[0].params;
+  setComponents(scene.materials[0], components);
   for (std::size_t t = 0; t < scene.triangleCount(); ++t) {
     glm::vec3 n = glm::normalize(glm::cross(scene.positions[3 * t + 1] - scene.positions[3 * t],
                                             scene.positions[3 * t + 2] - scene.positions[3 * t]));

@@ -304,12 +304,8 @@ TEST(EnvironmentRender, MisNeeAndBsdfSamplingAgreeWithASun) {
 // Bonferroni over 3 estimators x 3 channels.
 TEST(EnvironmentRender, LambertQuadUnderASunMatchesQuadratureOfTheMap) {
   Scene s;
-  Material m;
-  m.name = "floor";
-  m.model = findModel("lambert")->id;
   const float rho = 0.6f;
-  m.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(rho)}}, "floor");
-  s.materials.push_back(m);
+  s.materials.push_back(catalogueMaterial("lambert", {{"rho", ParamValue::num(rho)}}, "floor"));
   test::addQuad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
   s.environment = sunMap(64, 32, 1.0e4f);
   s.environment.rotateDegrees = 30.0f;

@@ -33,22 +33,11 @@ namespace {
 
 // Lambert materials: the catalogue's parameter, and emission.
 Material lambert(float rho, glm::vec3 emission = glm::vec3(0.0f), const char* name = "lambert") {
-  Material m;
-  m.name = name;
-  m.model = MODEL_LAMBERT;
-  m.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(rho)}}, name);
-  m.emission = emission;
-  return m;
+  return catalogueMaterial("lambert", {{"rho", ParamValue::num(rho)}}, name, emission);
 }
 
 Material withModel(const std::string& model, const NamedParams& params) {
-  const ModelSpec* spec = findModel(model);
-  EXPECT_NE(spec, nullptr) << model;
-  Material m;
-  m.name = model;
-  m.model = spec->id;
-  m.params = packParams(*spec, params, model);
-  return m;
+  return catalogueMaterial(model, params, model);
 }
 
 std::uint32_t addMaterial(Scene& s, const Material& m) {

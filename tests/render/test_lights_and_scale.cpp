@@ -19,11 +19,7 @@ const float kRho = 0.5f;
 Scene floorScene(int quadsPerSide = 1) {
   Scene s;
   s.sourcePath = "generated floor";
-  Material m;
-  m.name = "floor";
-  m.model = MODEL_LAMBERT;
-  m.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(kRho)}}, "test floor");
-  s.materials.push_back(m);
+  s.materials.push_back(catalogueMaterial("lambert", {{"rho", ParamValue::num(kRho)}}, "floor"));
   const float step = 4.0f / quadsPerSide;
   for (int j = 0; j < quadsPerSide; ++j)
     for (int i = 0; i < quadsPerSide; ++i) {
@@ -171,12 +167,8 @@ TEST(ShadeQueues, EachHitIsShadedByItsOwnModel) {
   // 11 tiles across 64 pixels: tile edges fall inside subgroups of 8 consecutive pixels.
   const int tiles = 11;
   Scene s = floorScene(tiles);
-  Material m2;
-  m2.name = "minnaert";
-  m2.model = MODEL_MINNAERT;
-  m2.params = packParams(*findModel("minnaert"), {{"rho", ParamValue::num(0.8)}, {"k", ParamValue::num(1.0)}}, "test");
-  s.materials[0].params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(0.2)}}, "test");
-  s.materials.push_back(m2);
+  s.materials[0] = catalogueMaterial("lambert", {{"rho", ParamValue::num(0.2)}}, "floor");
+  s.materials.push_back(catalogueMaterial("minnaert", {{"rho", ParamValue::num(0.8)}, {"k", ParamValue::num(1.0)}}, "minnaert"));
   for (std::size_t t = 0; t < s.triangleMaterial.size(); ++t) {
     int quad = int(t / 2), i = quad % tiles, j = quad / tiles;
     s.triangleMaterial[t] = (i + j) % 2;

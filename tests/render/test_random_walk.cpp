@@ -14,16 +14,6 @@ using namespace nusselt;
 
 namespace {
 
-Material makeMaterial(const std::string& name, const std::string& model, const NamedParams& params,
-                      glm::vec3 emission = glm::vec3(0.0f)) {
-  Material m;
-  m.name = name;
-  m.model = findModel(model)->id;
-  m.params = packParams(*findModel(model), params, name);
-  m.emission = emission;
-  return m;
-}
-
 using test::addQuad;
 
 void addSphere(Scene& s, glm::vec3 centre, float radius, std::uint32_t material, int nu = 96, int nv = 48) {
@@ -56,8 +46,8 @@ TEST(RandomWalk, MirrorShowsTheEmitterWhereGeometryPutsIt) {
   // at 45 degrees along (1, 0, -1); reflected rays travel along (1, 0, 1) and meet a vertical
   // emitter at x = 6 (facing -x) spanning z in [2, 4], y in [-1, 1].
   Scene s;
-  s.materials.push_back(makeMaterial("mirror", "mirror", {}));
-  s.materials.push_back(makeMaterial("emitter", "lambert", {{"rho", ParamValue::num(0)}}, glm::vec3(3.0f, 2.0f, 1.0f)));
+  s.materials.push_back(catalogueMaterial("mirror", {}, "mirror"));
+  s.materials.push_back(catalogueMaterial("lambert", {{"rho", ParamValue::num(0)}}, "emitter", glm::vec3(3.0f, 2.0f, 1.0f)));
   addQuad(s, {-10, -10, 0}, {10, -10, 0}, {10, 10, 0}, {-10, 10, 0}, 0);
   addQuad(s, {6, -1, 2}, {6, -1, 4}, {6, 1, 4}, {6, 1, 2}, 1);  // normal -x
   s.hasCamera = true;
@@ -126,7 +116,7 @@ TEST(RandomWalk, LosslessGlassSphereIsInvisibleInAUniformEnvironment) {
   // Every path through lossless glass escapes with weight exactly 1 (Fresnel choice, the radiance
   // scaling 1/eta^2 on entering undone on leaving), so every pixel equals the environment.
   Scene s;
-  s.materials.push_back(makeMaterial("glass", "dielectric", {{"eta", ParamValue::num(1.5)}}));
+  s.materials.push_back(catalogueMaterial("dielectric", {{"eta", ParamValue::num(1.5)}}, "glass"));
   addSphere(s, glm::vec3(0), 1.0f, 0);
   s.background = glm::vec3(0.7f, 1.0f, 1.3f);
   s.hasCamera = true;
@@ -152,8 +142,8 @@ TEST(RandomWalk, GlassSlabTransmitsFresnelFraction) {
   // faces and the slab transmits T^2 (1 + R^2 + R^4 + ...) = (1 - R) / (1 + R).
   const float eta = 1.5f;
   Scene s;
-  s.materials.push_back(makeMaterial("glass", "dielectric", {{"eta", ParamValue::num(eta)}}));
-  s.materials.push_back(makeMaterial("emitter", "lambert", {{"rho", ParamValue::num(0)}}, glm::vec3(2.0f)));
+  s.materials.push_back(catalogueMaterial("dielectric", {{"eta", ParamValue::num(eta)}}, "glass"));
+  s.materials.push_back(catalogueMaterial("lambert", {{"rho", ParamValue::num(0)}}, "emitter", glm::vec3(2.0f)));
   addQuad(s, {-5, -5, 0}, {5, -5, 0}, {5, 5, 0}, {-5, 5, 0}, 0);          // front face, normal +z
   addQuad(s, {-5, -5, -0.2f}, {-5, 5, -0.2f}, {5, 5, -0.2f}, {5, -5, -0.2f}, 0);  // back, normal -z
   addQuad(s, {-50, -50, -3}, {50, -50, -3}, {50, 50, -3}, {-50, 50, -3}, 1);     // emitter, normal +z

@@ -14,11 +14,7 @@ using namespace nusselt;
 namespace {
 
 MaterialComponent component(const std::string& model, float weight) {
-  MaterialComponent c;
-  c.model = findModel(model)->id;
-  c.weight = weight;
-  c.params = packParams(*findModel(model), typicalParams(*findModel(model)), model);
-  return c;
+  return catalogueComponent(model, typicalParams(*findModel(model)), weight);
 }
 
 // The MIS test scene (a floor under a large dim and a small bright light) with a glossy floor:
@@ -26,9 +22,8 @@ MaterialComponent component(const std::string& model, float weight) {
 Scene glossyScene(const std::vector<MaterialComponent>& components) {
   Scene scene = test::loadTestScene("scenes/tests/mis.gltf");
   Material& floor = scene.materials[0];
-  floor.model = components[0].model;
-  floor.params = components[0].params;
-  if (components.size() > 1) floor.components = components;
+  if (components.size() > 1) setComponents(floor, components);
+  else floor.model = components[0].model, floor.params = components[0].params;
   return scene;
 }
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <vector>
 
 #include "../support/test_support.h"
@@ -67,15 +68,42 @@ void lookDown(Scene& s, float height, float mag) {
   s.camera.xmag = s.camera.ymag = mag;
 }
 
+// The 16 x 16, 4 spp render of the exact-value tests below.
+RenderSettings exactSettings(std::uint32_t maxDepth, std::uint32_t seed) {
+  RenderSettings rs;
+  rs.width = rs.height = 16;
+  rs.spp = 4;
+  rs.maxDepth = maxDepth;
+  rs.seed = seed;
+  return rs;
+}
+
+// Compares every pixel and channel of a 16 x 16 image with expected(px, py, k), within
+// rel x expected + abs; reports the first five misses (prefixed by `what`) and returns their count.
+int pixelMisses(const Image& image, const std::function<double(int, int, int)>& expected, double rel, double abs,
+                const std::string& what = "") {
+  int bad = 0;
+  for (int py = 0; py < 16; ++py)
+    for (int px = 0; px < 16; ++px)
+      for (int k = 0; k < 3; ++k) {
+        const double e = expected(px, py, k), got = image.rgb[3 * (py * 16 + px) + k];
+        if (!(std::fabs(got - e) <= rel * std::fabs(e) + abs) && ++bad <= 5)
+          ADD_FAILURE() << what << "pixel (" << px << ", " << py << ") channel " << k << ": " << got << ", expected " << e;
+      }
+  return bad;
+}
+
+Material lambert(const std::string& name, double rho) {
+  return catalogueMaterial("lambert", {{"rho", ParamValue::num(rho)}}, name);
+}
+
 Material gltfPbr(glm::vec3 base, float metallic, float roughness) {
-  Material m;
-  m.name = "pbr";
-  m.model = MODEL_GLTF_PBR;
-  m.params = packParams(*findModel("gltf_pbr"),
-                        {{"baseColor", arrayValue({ParamValue::num(base.x), ParamValue::num(base.y), ParamValue::num(base.z)})},
-                         {"metallic", ParamValue::num(metallic)},
-                         {"roughness", ParamValue::num(roughness)}},
-                        "test");
+  Material m = catalogueMaterial(
+      "gltf_pbr",
+      {{"baseColor", arrayValue({ParamValue::num(base.x), ParamValue::num(base.y), ParamValue::num(base.z)})},
+       {"metallic", ParamValue::num(metallic)},
+       {"roughness", ParamValue::num(roughness)}},
+      "pbr");
   m.baseColorFactor = glm::vec4(base, 1.0f);
   m.metallicFactor = metallic;
   m.roughnessFactor = roughness;
@@ -101,24 +129,10 @@ TEST(TexturesRender, EmissiveTextureSeenByTheCameraReproducesTheTexels) {
   s.materials.push_back(m);
   addTexturedQuad(s, 0.0f, 0);
   lookDown(s, 1.0f, 1.0f);
-  RenderSettings rs;
-  rs.width = rs.height = 16;
-  rs.spp = 4;
-  rs.maxDepth = 0;
-  rs.seed = 5;
-  test::Rendered r = test::render(s, rs);
-  int bad = 0;
-  for (int py = 0; py < 16; ++py)
-    for (int px = 0; px < 16; ++px) {
-      const int* c = kCodes[px / 8 + 2 * (py / 8)];
-      for (int k = 0; k < 3; ++k) {
-        double expected = m.emission[k] * srgb(c[k]);
-        double got = r.image.rgb[3 * (py * 16 + px) + k];
-        if (!(std::fabs(got - expected) <= 1e-5 * expected + 1e-7) && ++bad <= 5)
-          ADD_FAILURE() << "pixel (" << px << ", " << py << ") channel " << k << ": " << got << ", expected " << expected;
-      }
-    }
-  EXPECT_EQ(bad, 0);
+  test::Rendered r = test::render(s, exactSettings(0, 5));
+  EXPECT_EQ(pixelMisses(r.image, [&](int px, int py, int k) { return m.emission[k] * srgb(kCodes[px / 8 + 2 * (py / 8)][k]); },
+                        1e-5, 1e-7),
+            0);
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
@@ -131,15 +145,8 @@ TEST(TexturesRender, EmissiveTextureSeenByTheCameraReproducesTheTexels) {
 // dim half by many standard errors.
 TEST(TexturesRender, TexturedEmitterNeeBsdfAndMisAgree) {
   Scene s;
-  Material floor;
-  floor.name = "floor";
-  floor.model = findModel("lambert")->id;
-  floor.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(0.7)}}, "floor");
-  s.materials.push_back(floor);
-  Material lamp;
-  lamp.name = "lamp";
-  lamp.model = findModel("lambert")->id;
-  lamp.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(0.0)}}, "lamp");
+  s.materials.push_back(lambert("floor", 0.7));
+  Material lamp = lambert("lamp", 0.0);
   lamp.emission = glm::vec3(6.0f);
   TextureRef t;
   t.image = addImage(s, 4, 1, [](int x, int) {
@@ -292,10 +299,7 @@ TEST(TexturesRender, ConstantNormalMapShadesAsTheTiltedPlane) {
     glm::ivec3 code;
     for (int k = 0; k < 3; ++k) code[k] = int(std::lround((ts[q][k] + 1.0f) * 0.5f * 255.0f));
     int image = addImage(s, 1, 1, [&](int, int) { return glm::ivec4(code, 255); });
-    Material m;
-    m.name = q == 0 ? "tangent" : "bitangent";
-    m.model = findModel("lambert")->id;
-    m.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(0.5)}}, m.name);
+    Material m = lambert(q == 0 ? "tangent" : "bitangent", 0.5);
     m.normalTexture = nearest(image, ColorSpace::Linear);
     m.normalScale = scale[q];
     s.materials.push_back(m);
@@ -318,41 +322,19 @@ TEST(TexturesRender, ConstantNormalMapShadesAsTheTiltedPlane) {
   sun.intensity = glm::vec3(2.0f);
   s.lights.push_back(sun);
   lookDown(s, 1.0f, 1.0f);
-  RenderSettings rs;
-  rs.width = rs.height = 16;
-  rs.spp = 4;
-  rs.maxDepth = 1;
-  rs.seed = 3;
-  test::Rendered r = test::render(s, rs);
-  int bad = 0;
+  test::Rendered r = test::render(s, exactSettings(1, 3));
   double value[2];
   for (int q = 0; q < 2; ++q) value[q] = 0.5 / M_PI * 2.0 * std::max(0.0f, glm::dot(expectedNormal[q], l));
   const double flat = 0.5 / M_PI * 2.0 * l.z;
   EXPECT_GT(std::fabs(value[0] - flat), 0.05 * flat);  // the maps change the image
   EXPECT_GT(std::fabs(value[1] - flat), 0.05 * flat);
-  for (int py = 0; py < 16; ++py)
-    for (int px = 0; px < 16; ++px) {
-      double expected = value[px < 8 ? 0 : 1];
-      for (int k = 0; k < 3; ++k) {
-        double got = r.image.rgb[3 * (py * 16 + px) + k];
-        if (!(std::fabs(got - expected) <= 1e-4 * expected) && ++bad <= 5)
-          ADD_FAILURE() << "pixel (" << px << ", " << py << ") channel " << k << ": " << got << ", expected " << expected
-                        << " (flat " << flat << ")";
-      }
-    }
-  EXPECT_EQ(bad, 0);
+  EXPECT_EQ(pixelMisses(r.image, [&](int px, int, int) { return value[px < 8 ? 0 : 1]; }, 1e-4, 0.0,
+                        "flat " + std::to_string(flat) + ": "),
+            0);
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
 namespace {
-
-Material lambert(const std::string& name, double rho) {
-  Material m;
-  m.name = name;
-  m.model = findModel("lambert")->id;
-  m.params = packParams(*findModel("lambert"), {{"rho", ParamValue::num(rho)}}, name);
-  return m;
-}
 
 // The traversals this device has: the GLSL BVH, and ray queries when offered.
 std::vector<Traversal> traversals() {
@@ -384,24 +366,11 @@ TEST(TexturesRender, MaskCutsOutWhereAlphaIsBelowTheCutoff) {
   addTexturedQuad(s, 0.5f, 1);
   lookDown(s, 1.0f, 1.0f);
   for (Traversal tr : traversals()) {
-    RenderSettings rs;
-    rs.width = rs.height = 16;
-    rs.spp = 4;
-    rs.maxDepth = 0;
-    rs.seed = 9;
+    RenderSettings rs = exactSettings(0, 9);
     rs.traversal = tr;
     test::Rendered r = test::render(s, rs);
-    int bad = 0;
-    for (int py = 0; py < 16; ++py)
-      for (int px = 0; px < 16; ++px) {
-        const bool opaque = alphaCode[px / 8 + 2 * (py / 8)] / 255.0f >= 0.5f;
-        const float expected = opaque ? 0.0f : 1.0f;
-        for (int k = 0; k < 3; ++k)
-          if (std::fabs(r.image.rgb[3 * (py * 16 + px) + k] - expected) > 1e-6f && ++bad <= 5)
-            ADD_FAILURE() << (tr == Traversal::Bvh ? "bvh" : "rayquery") << " pixel (" << px << ", " << py
-                          << "): " << r.image.rgb[3 * (py * 16 + px) + k] << ", expected " << expected;
-      }
-    EXPECT_EQ(bad, 0);
+    auto expected = [&](int px, int py, int) { return alphaCode[px / 8 + 2 * (py / 8)] / 255.0f >= 0.5f ? 0.0 : 1.0; };
+    EXPECT_EQ(pixelMisses(r.image, expected, 0.0, 1e-6, tr == Traversal::Bvh ? "bvh " : "rayquery "), 0);
   }
   EXPECT_EQ(test::validationMessages(), 0u);
 }
