@@ -33,7 +33,7 @@ SHARED_BEGIN
 // Does the model have its own sampler here (else analyticSample is cosine sampling)?
 SHARED_FN bool analyticHasSampler(uint model) {
   switch (model) {
-    NUSSELT_MODELS(NUSSELT_ANALYTIC_HAS)
+    NUSSELT_DISPATCH_MODELS(NUSSELT_ANALYTIC_HAS)
     default: break;
   }
   return false;
@@ -46,7 +46,7 @@ SHARED_FN bool analyticHasSampler(uint model) {
 SHARED_FN float analyticPdf(uint model, BrdfParams p, vec3 wo, vec3 wi) {
   if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
   switch (model) {
-    NUSSELT_MODELS(NUSSELT_ANALYTIC_PDF)
+    NUSSELT_DISPATCH_MODELS(NUSSELT_ANALYTIC_PDF)
     default: break;
   }
   return wi.z * NUSSELT_INV_PI;
@@ -64,7 +64,7 @@ SHARED_FN bool analyticSample(uint model, BrdfParams p, vec3 wo, vec2 u, OUT(vec
   vec3 d = vec3(0.0f, 0.0f, 1.0f);
   bool ok;
   switch (model) {
-    NUSSELT_MODELS(NUSSELT_ANALYTIC_SAMPLE)
+    NUSSELT_DISPATCH_MODELS(NUSSELT_ANALYTIC_SAMPLE)
     default: ok = analyticCosineSample(u.x, u.y, d); break;
   }
   if (!ok || !(d.z > 0.0f)) return false;

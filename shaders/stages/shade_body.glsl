@@ -15,7 +15,12 @@
 #include "shared/combined.h"
 STAGE_PUSH(BounceConstants);
 
+#ifdef NUSSELT_SHADE_MODEL_ID
+// A module built for one model (shade_<model>_sN, CMakeLists.txt): its id is a constant.
+const uint MODEL_ID = NUSSELT_SHADE_MODEL_ID;
+#else
 layout(constant_id = 0) const uint MODEL_ID = 0u;
+#endif
 layout(constant_id = 1) const uint SAMPLER = SAMPLER_QUADTREE;
 #if SHADE_COMBINED
 // 1..MAX_COMPONENTS: the number of components of the combined material.

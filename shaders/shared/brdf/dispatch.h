@@ -15,7 +15,7 @@ SHARED_FN bool modelIsDelta(uint model) {
 #define NUSSELT_DELTA_CASE_0(NAME, fn)
 #define NUSSELT_DELTA_CASE(id, NAME, fn) NUSSELT_CAT(NUSSELT_DELTA_CASE_, NAME##_DELTA)(NAME, fn)
   switch (model) {
-    NUSSELT_MODELS(NUSSELT_DELTA_CASE)
+    NUSSELT_DISPATCH_MODELS(NUSSELT_DELTA_CASE)
     default: break;
   }
   return false;
@@ -26,7 +26,7 @@ SHARED_FN bool modelIsDelta(uint model) {
 SHARED_FN vec3 brdfEval(uint model, BrdfParams p, vec3 wi, vec3 wo) {
 #define NUSSELT_EVAL_CASE(id, NAME, fn) case MODEL_##NAME: return fn##Eval(p, wi, wo);
   switch (model) {
-    NUSSELT_MODELS(NUSSELT_EVAL_CASE)
+    NUSSELT_DISPATCH_MODELS(NUSSELT_EVAL_CASE)
     default: break;
   }
   return vec3(0.0f);
@@ -46,7 +46,7 @@ SHARED_FN vec3 brdfEval(uint model, BrdfParams p, vec3 wi, vec3 wo) {
 SHARED_FN bool deltaSample(uint model, BrdfParams p, vec3 wo, bool inside, vec2 u, OUT(vec3) wi, OUT(vec3) weight,
                            OUT(float) continuation) {
   switch (model) {
-    NUSSELT_MODELS(NUSSELT_DELTA_SAMPLE)
+    NUSSELT_DISPATCH_MODELS(NUSSELT_DELTA_SAMPLE)
     default: break;
   }
   return false;
@@ -57,7 +57,7 @@ SHARED_FN bool deltaSample(uint model, BrdfParams p, vec3 wo, bool inside, vec2 
 #define NUSSELT_DELTA_ALBEDO(id, NAME, fn) NUSSELT_CAT(NUSSELT_DELTA_ALBEDO_, NAME##_DELTA)(NAME, fn)
 SHARED_FN float deltaChoiceAlbedo(uint model, BrdfParams p, vec3 wo, bool largestChannel) {
   switch (model) {
-    NUSSELT_MODELS(NUSSELT_DELTA_ALBEDO)
+    NUSSELT_DISPATCH_MODELS(NUSSELT_DELTA_ALBEDO)
     default: break;
   }
   return 0.0f;
@@ -71,7 +71,7 @@ SHARED_FN float deltaChoiceAlbedo(uint model, BrdfParams p, vec3 wo, bool larges
 // surface, 1 for everything else (only delta models transmit).
 SHARED_FN float transmissionEtaScale(uint model, BrdfParams p, bool inside) {
   switch (model) {
-    NUSSELT_MODELS(NUSSELT_ETA_SCALE)
+    NUSSELT_DISPATCH_MODELS(NUSSELT_ETA_SCALE)
     default: break;
   }
   return 1.0f;
