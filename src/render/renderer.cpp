@@ -6,11 +6,14 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <set>
 
 #include "../../shaders/shared/layout.h"
+#include "brdf/merl.h"
 #include "render/environment.h"
 #include "render/guide.h"
 #include "render/path_integrator.h"
+#include "render/texture_table.h"
 #include "util/error.h"
 
 namespace nusselt {
@@ -73,8 +76,16 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
       throw Error("environment map '" + scene.environment.path + "' (" + std::to_string(scene.environment.width) + "x" +
                   std::to_string(scene.environment.height) + ") needs " + mib(envBytes) + " of device memory, more than " +
                   m_ctx.deviceName + " allows in one allocation (" + mib(m_ctx.maxAllocation) + "): use a smaller map");
+    // Measured (merl) tables: each distinct file once (MaterialTable), as floats.
+    std::set<std::uint32_t> measured;
+    for (const Material& m : scene.materials) {
+      if (m.model == MODEL_MERL && m.components.empty()) measured.insert(merlSlot(m.params));
+      for (const MaterialComponent& c : m.components)
+        if (c.model == MODEL_MERL) measured.insert(merlSlot(c.params));
+    }
     const std::uint64_t need = DeviceScene::bytesFor(scene.triangleCount(), lightBound + 1,
                                                      m_settings.traversal == Traversal::RayQuery) + envBytes +
+                               textureDeviceBytes(scene) + measured.size() * MERL_TABLE_FLOATS * sizeof(float) +
                                std::max<std::size_t>(scene.materials.size(), 1) * sizeof(shared::GpuMaterial) +
                                Film::bytesFor(pixels) + PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS) +
                                (settings.guiding ? DeviceGuide::bytesFor(settings.guideMemory, capacity, settings.maxDepth) : 0);
@@ -87,8 +98,10 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
                   std::to_string(m_ctx.maxAllocation / 16) + " pixels)");
     if (have && need > have)
       throw Error("the render needs about " + mib(need) + " of device memory (" + std::to_string(scene.triangleCount()) +
-                  " triangles, " + std::to_string(settings.width) + "x" + std::to_string(settings.height) +
-                  " pixels) but " + m_ctx.deviceName + " has " + mib(have) + ": use a smaller image or a simpler scene");
+                  " triangles, " + std::to_string(settings.width) + "x" + std::to_string(settings.height) + " pixels" +
+                  (textureDeviceBytes(scene) ? ", " + mib(textureDeviceBytes(scene)) + " of textures" : std::string()) +
+                  (measured.empty() ? std::string() : ", " + std::to_string(measured.size()) + " measured tables") +
+                  ") but " + m_ctx.deviceName + " has " + mib(have) + ": use a smaller image or a simpler scene");
   }
 
   m_globals = std::make_unique<StageGlobals>(m_ctx, STAGE_PUSH_BYTES);

@@ -2,6 +2,7 @@
 #include "render/texture_table.h"
 
 #include <map>
+#include <set>
 
 #include "util/error.h"
 
@@ -22,11 +23,17 @@ MaterialTextureUse textureUse(const Material& m, const Scene& scene) {
 }
 
 namespace {
-template <class F>
-bool anyUsedMaterial(const Scene& scene, F f) {
+// The materials some triangle uses.
+std::vector<bool> usedMaterials(const Scene& scene) {
   std::vector<bool> used(scene.materials.size(), false);
   for (std::uint32_t m : scene.triangleMaterial)
     if (m < used.size()) used[m] = true;
+  return used;
+}
+
+template <class F>
+bool anyUsedMaterial(const Scene& scene, F f) {
+  const std::vector<bool> used = usedMaterials(scene);
   for (std::size_t i = 0; i < scene.materials.size(); ++i)
     if (used[i] && f(textureUse(scene.materials[i], scene))) return true;
   return false;
@@ -68,29 +75,55 @@ GpuTexture packTexture(const TextureRef& ref, const TextureImage& image, std::ui
   return t;
 }
 
+namespace {
+enum TextureSlot { SlotBaseColor, SlotMetallicRoughness, SlotEmissive, SlotNormal, SlotCoverage };
+
+// Calls fn(material index, slot, reference, description) for every texture the renderer applies,
+// in the order of the texture records: per material (those a triangle uses), baseColor,
+// metallicRoughness, emissive, normal, then the coverage map (the base-colour texture read for
+// its alpha by a material whose base colour is not textured).
+template <class F>
+void forEachAppliedTexture(const Scene& scene, F fn) {
+  const std::vector<bool> used = usedMaterials(scene);
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    if (!used[i]) continue;
+    const Material& m = scene.materials[i];
+    const MaterialTextureUse u = textureUse(m, scene);
+    if (u.baseColor) fn(i, SlotBaseColor, m.baseColorTexture, m.name + " baseColorTexture");
+    if (u.metallicRoughness) fn(i, SlotMetallicRoughness, m.metallicRoughnessTexture, m.name + " metallicRoughnessTexture");
+    if (u.emissive) fn(i, SlotEmissive, m.emissiveTexture, m.name + " emissiveTexture");
+    if (u.normal) fn(i, SlotNormal, m.normalTexture, m.name + " normalTexture");
+    if (u.alpha && m.baseColorTexture.present() && !u.baseColor)
+      fn(i, SlotCoverage, m.baseColorTexture, m.name + " baseColorTexture (alpha)");
+  }
+}
+
+const TextureImage& appliedImage(const Scene& scene, const TextureRef& ref, const std::string& what) {
+  if (ref.image < 0 || std::size_t(ref.image) >= scene.images.size())
+    throw Error("internal: " + what + " names image " + std::to_string(ref.image) + " of " +
+                std::to_string(scene.images.size()));
+  const TextureImage& image = scene.images[std::size_t(ref.image)];
+  if (image.width == 0 || image.height == 0) throw Error("internal: image " + image.name + " is empty");
+  return image;
+}
+}  // namespace
+
+std::uint64_t textureDeviceBytes(const Scene& scene) {
+  if (!sceneUsesTextures(scene)) return 0;
+  std::set<std::int32_t> images;
+  std::uint64_t texels = 0, records = 0;
+  forEachAppliedTexture(scene, [&](std::size_t, TextureSlot, const TextureRef& ref, const std::string& what) {
+    const TextureImage& image = appliedImage(scene, ref, what);
+    if (images.insert(ref.image).second) texels += std::uint64_t(image.width) * image.height;
+    ++records;
+  });
+  return texels * 4 + records * sizeof(shared::GpuTexture) + scene.materials.size() * sizeof(shared::GpuMaterialTextures);
+}
+
 TextureData buildTextureData(const Scene& scene) {
   TextureData d;
   if (!sceneUsesTextures(scene)) return d;
-  std::vector<bool> used(scene.materials.size(), false);
-  for (std::uint32_t m : scene.triangleMaterial)
-    if (m < used.size()) used[m] = true;
   std::map<std::int32_t, std::uint32_t> firstTexel;  // scene image -> its texels in the buffer
-  auto add = [&](const TextureRef& ref, const std::string& what) -> std::uint32_t {
-    if (ref.image < 0 || std::size_t(ref.image) >= scene.images.size())
-      throw Error("internal: " + what + " names image " + std::to_string(ref.image) + " of " +
-                  std::to_string(scene.images.size()));
-    const TextureImage& image = scene.images[std::size_t(ref.image)];
-    if (image.width == 0 || image.height == 0) throw Error("internal: image " + image.name + " is empty");
-    auto it = firstTexel.find(ref.image);
-    if (it == firstTexel.end()) {
-      std::vector<std::uint32_t> t = packTexels(image);
-      if (d.texels.size() + t.size() > UINT32_MAX) throw Error("the scene's textures exceed 2^32 texels");
-      it = firstTexel.emplace(ref.image, std::uint32_t(d.texels.size())).first;
-      d.texels.insert(d.texels.end(), t.begin(), t.end());
-    }
-    d.textures.push_back(packTexture(ref, image, it->second));
-    return std::uint32_t(d.textures.size() - 1);
-  };
   d.materials.resize(scene.materials.size());
   for (std::size_t i = 0; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
@@ -99,16 +132,29 @@ TextureData buildTextureData(const Scene& scene) {
     g.baseColorFactor = m.baseColorFactor;
     g.factors = glm::vec4(m.metallicFactor, m.roughnessFactor, m.normalScale, m.alphaCutoff);
     g.alpha = glm::uvec4(static_cast<std::uint32_t>(m.alphaMode), INVALID_INDEX, 0u, 0u);
-    if (!used[i]) continue;
-    const MaterialTextureUse u = textureUse(m, scene);
-    if (u.baseColor) g.maps.x = add(m.baseColorTexture, m.name + " baseColorTexture");
-    if (u.metallicRoughness) g.maps.y = add(m.metallicRoughnessTexture, m.name + " metallicRoughnessTexture");
-    if (u.emissive) g.maps.z = add(m.emissiveTexture, m.name + " emissiveTexture");
-    if (u.normal) g.maps.w = add(m.normalTexture, m.name + " normalTexture");
-    // Coverage: the base-colour texture's alpha, for any model (its RGB applies to gltf_pbr only).
-    if (u.alpha && m.baseColorTexture.present())
-      g.alpha.y = u.baseColor ? g.maps.x : add(m.baseColorTexture, m.name + " baseColorTexture (alpha)");
   }
+  forEachAppliedTexture(scene, [&](std::size_t i, TextureSlot slot, const TextureRef& ref, const std::string& what) {
+    const TextureImage& image = appliedImage(scene, ref, what);
+    auto it = firstTexel.find(ref.image);
+    if (it == firstTexel.end()) {
+      std::vector<std::uint32_t> t = packTexels(image);
+      if (d.texels.size() + t.size() > UINT32_MAX) throw Error("the scene's textures exceed 2^32 texels");
+      it = firstTexel.emplace(ref.image, std::uint32_t(d.texels.size())).first;
+      d.texels.insert(d.texels.end(), t.begin(), t.end());
+    }
+    d.textures.push_back(packTexture(ref, image, it->second));
+    const std::uint32_t index = std::uint32_t(d.textures.size() - 1);
+    GpuMaterialTextures& g = d.materials[i];
+    switch (slot) {
+      case SlotBaseColor: g.maps.x = index; break;
+      case SlotMetallicRoughness: g.maps.y = index; break;
+      case SlotEmissive: g.maps.z = index; break;
+      case SlotNormal: g.maps.w = index; break;
+      case SlotCoverage: g.alpha.y = index; break;
+    }
+    // Coverage: the base-colour texture's alpha, for any model (its RGB applies to gltf_pbr only).
+    if (slot == SlotBaseColor && textureUse(scene.materials[i], scene).alpha) g.alpha.y = index;
+  });
   return d;
 }
 

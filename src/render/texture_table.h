@@ -38,6 +38,8 @@ struct TextureData {
   std::vector<shared::GpuMaterialTextures> materials;  // one per scene material
 };
 TextureData buildTextureData(const Scene& scene);
+// Device memory of buildTextureData's buffers for this scene, without packing any texel.
+std::uint64_t textureDeviceBytes(const Scene& scene);
 
 // One texture record; its texels start at firstTexel of the texel buffer.
 shared::GpuTexture packTexture(const TextureRef& ref, const TextureImage& image, std::uint32_t firstTexel);

@@ -167,5 +167,43 @@ TEST(TextureLookup, TransformAndCoordinateSet) {
   EXPECT_NEAR(shared::textureLookup(two.data(), shifted, glm::vec2(0.1f, 0.2f)).x, R(1, 1), kEps);
 }
 
+// The device memory the render's pre-check counts for textures equals what buildTextureData
+// packs: each applied image once (one image shared by two materials and slots), the coverage map
+// of a material whose base colour is not textured, nothing for a material no triangle uses.
+TEST(TextureTable, DeviceBytesMatchThePackedBuffers) {
+  Scene s;
+  s.images = {image3x2(), image3x2()};
+  s.images[1].width = 1;
+  s.images[1].height = 1;
+  s.images[1].rgba.resize(4);
+  TextureRef shared0, other;
+  shared0.image = 0;
+  other.image = 1;
+  Material pbr = catalogueMaterial("gltf_pbr", {}, "pbr");
+  pbr.baseColorTexture = shared0;
+  pbr.alphaMode = AlphaMode::Mask;  // coverage from the (applied) base-colour texture
+  Material lamp = catalogueMaterial("lambert", {}, "lamp", glm::vec3(1.0f));
+  lamp.emissiveTexture = shared0;
+  lamp.baseColorTexture = other;  // not applied to lambert's colour: a coverage map only
+  lamp.alphaMode = AlphaMode::Blend;
+  Material unused = catalogueMaterial("gltf_pbr", {}, "unused");
+  unused.baseColorTexture = other;
+  s.materials = {pbr, lamp, unused};
+  for (std::uint32_t m : {0u, 1u}) {
+    s.positions.insert(s.positions.end(), {glm::vec3(0), glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)});
+    s.normals.insert(s.normals.end(), 3, glm::vec3(0, 0, 1));
+    s.triangleMaterial.push_back(m);
+  }
+  const TextureData d = buildTextureData(s);
+  EXPECT_EQ(d.texels.size(), 7u);    // 3 x 2 + 1 x 1, each once
+  EXPECT_EQ(d.textures.size(), 3u);  // pbr base colour, lamp emissive, lamp coverage
+  EXPECT_EQ(d.materials[0].alpha.y, d.materials[0].maps.x);
+  EXPECT_EQ(d.materials[1].alpha.y, 2u);
+  EXPECT_EQ(textureDeviceBytes(s), d.texels.size() * 4 + d.textures.size() * sizeof(GpuTexture) +
+                                       d.materials.size() * sizeof(shared::GpuMaterialTextures));
+  s.triangleMaterial = {2u, 2u};  // only the unused material's texture... now used, alone
+  EXPECT_EQ(textureDeviceBytes(s), 4 + sizeof(GpuTexture) + 3 * sizeof(shared::GpuMaterialTextures));
+}
+
 }  // namespace
 }  // namespace nusselt
