@@ -29,6 +29,9 @@ inline std::vector<Source> sources() {
   const ModelSpec* ts = findModel("torrance_sparrow");
   return {{"lambert05", "lambert", {{"rho", ParamValue::num(0.5)}}}, {"glossy", "torrance_sparrow", typicalParams(*ts)}};
 }
+// A sharp table: ward's typical set (1992 normalisation, f ~ 1/sqrt(cos) at the horizon), whose
+// nodes next to the horizon are up to 1e7 times their neighbours (docs/measured.md, Limits).
+inline Source wardSource() { return {"ward", "ward", typicalParams(*findModel("ward"))}; }
 
 // A folder for this process's files (35 MB each), removed at exit.
 inline std::string tempDir() {
