@@ -1254,7 +1254,9 @@ Tree Builder::build() {
       }
     }
     if (leaf && mass > 0) {
-      polish(cell, fr, all, env, accepts(mass, env) ? 0 : kLowLeafLattice);
+      // merl: no search between the points; certify proves the envelope (or grows it) exactly
+      // (6% fewer evaluations of f and 1% fewer leaves on the ward table).
+      if (!m_merl) polish(cell, fr, all, env, accepts(mass, env) ? 0 : kLowLeafLattice);
       bool proven = true;
       if (m_merl) {
         // The largest growth with which the leaf is kept (accepted, or a tail leaf; any at the
