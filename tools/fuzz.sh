@@ -4,14 +4,14 @@
 # Exits non-zero on a finding (crash, sanitizer report, leak, timeout, out-of-memory); the
 # reproducer is left in build-fuzz/findings/. Installs nothing: needs clang and
 # libclang-rt-14-dev (tools/bootstrap.sh).
-# Usage: tools/fuzz.sh [SECONDS] [fuzzer...]      fuzzers: fuzz_gltf fuzz_brdf_params fuzz_image fuzz_hdr
+# Usage: tools/fuzz.sh [SECONDS] [fuzzer...]      fuzzers: fuzz_gltf fuzz_brdf_params fuzz_image fuzz_hdr fuzz_merl
 # Extra libFuzzer flags: FUZZ_FLAGS="-jobs=2 -workers=2" tools/fuzz.sh 1800 fuzz_gltf
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 fuzzers=("$@")
-[ ${#fuzzers[@]} -gt 0 ] || fuzzers=(fuzz_gltf fuzz_brdf_params fuzz_image fuzz_hdr)
+[ ${#fuzzers[@]} -gt 0 ] || fuzzers=(fuzz_gltf fuzz_brdf_params fuzz_image fuzz_hdr fuzz_merl)
 
 for tool in clang clang++; do
   command -v $tool >/dev/null || { echo "fuzz.sh: $tool not found (apt-get install clang libclang-rt-14-dev)" >&2; exit 2; }
@@ -21,8 +21,9 @@ CC=clang CXX=clang++ cmake -S . -B $build -G Ninja -DCMAKE_BUILD_TYPE=RelWithDeb
   -DNUSSELT_TESTS=OFF >/dev/null
 cmake --build $build --target "${fuzzers[@]}"
 
-declare -A corpus=([fuzz_gltf]=gltf [fuzz_brdf_params]=params [fuzz_image]=image [fuzz_hdr]=hdr)
-declare -A dict=([fuzz_gltf]=gltf.dict [fuzz_brdf_params]=params.dict [fuzz_image]=image.dict [fuzz_hdr]=hdr.dict)
+declare -A corpus=([fuzz_gltf]=gltf [fuzz_brdf_params]=params [fuzz_image]=image [fuzz_hdr]=hdr [fuzz_merl]=merl)
+declare -A dict=([fuzz_gltf]=gltf.dict [fuzz_brdf_params]=params.dict [fuzz_image]=image.dict [fuzz_hdr]=hdr.dict
+                 [fuzz_merl]=merl.dict)
 status=0
 mkdir -p $build/findings
 for f in "${fuzzers[@]}"; do
@@ -43,7 +44,7 @@ for f in "${fuzzers[@]}"; do
   execs=$(grep -h 'stat::number_of_executed_units' "$log" | awk '{s += $2} END {print s + 0}')
   if [ $rc -ne 0 ]; then
     echo "!! $f: FINDING (exit $rc) after $execs executions; log: $log" >&2
-    grep -E 'ERROR|runtime error|SUMMARY|fuzz_gltf:|fuzz_brdf_params:|fuzz_image:|fuzz_hdr:|Test unit written' "$log" | head -20 >&2 || true
+    grep -E 'ERROR|runtime error|SUMMARY|fuzz_gltf:|fuzz_brdf_params:|fuzz_image:|fuzz_hdr:|fuzz_merl:|Test unit written' "$log" | head -20 >&2 || true
     status=1
   else
     echo "   $f: ok, $execs executions in ${seconds}s, $(grep -h 'cov:' "$log" | tail -1 | grep -o 'cov: [0-9]*')"

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite, as CI runs it (the README's second command):
 #   1. the CPU-side suite under AddressSanitizer + UndefinedBehaviorSanitizer (build-asan/);
-#   2. the glTF, image, RGBE and NUSSELT_brdf fuzzers for a bounded time each (build-fuzz/, clang);
+#   2. the glTF, image, RGBE, NUSSELT_brdf and MERL fuzzers for a bounded time each (build-fuzz/, clang);
 #   3. the main suite: ctest on build/ (unit, GPU, render and command-line tests on the machine's
 #      Vulkan device, lavapipe without a GPU, with the validation layer on).
 # Needs tools/bootstrap.sh to have run (the README's first command). Stops at the first failure.

@@ -34,7 +34,9 @@ std::size_t node(int i, int j, int k) { return (std::size_t(i) * kD + std::size_
 // Fills the nodes marked unmeasured from the nearest measured node along theta_d (ties: the
 // smaller theta_d), then along theta_h, then along phi_d (periodic), each pass using what the
 // previous ones filled. Returns false when no node is measured.
-bool fillUnmeasured(std::vector<float>& rgb, std::vector<unsigned char>& measured) {
+bool fillUnmeasured(std::vector<float>& rgb, std::vector<unsigned char>& measured, const MerlDims& dims) {
+  const int kH = dims.thetaH, kD = dims.thetaD, kP = dims.phiD;
+  auto node = [&](int i, int j, int k) { return (std::size_t(i) * kD + std::size_t(j)) * kP + std::size_t(k); };
   auto copy = [&](std::size_t to, std::size_t from) {
     for (int c = 0; c < 3; ++c) rgb[3 * to + c] = rgb[3 * from + c];
   };
@@ -109,6 +111,55 @@ const MerlTable& merlTable(const BrdfParams& params) {
   return *g_store[slot];
 }
 
+MerlTable decodeMerl(const unsigned char* bytes, std::size_t size, const std::string& displayName, const MerlDims& dims) {
+  const std::string who = displayName + ": ";
+  const std::uint64_t nodes = std::uint64_t(dims.thetaH) * std::uint64_t(dims.thetaD) * std::uint64_t(dims.phiD);
+  const std::uint64_t expected = 12 + 3 * nodes * 8;
+  const std::string layout = "(" + std::to_string(dims.thetaH) + ", " + std::to_string(dims.thetaD) + ", " +
+                             std::to_string(dims.phiD) + ")";
+  if (size < 12)
+    throw Error(who + "truncated: " + std::to_string(size) + " bytes, shorter than the 12-byte dimension header");
+  std::int32_t found[3];
+  std::memcpy(found, bytes, 12);
+  if (found[0] != dims.thetaH || found[1] != dims.thetaD || found[2] != dims.phiD)
+    throw Error(who + "dimension header (" + std::to_string(found[0]) + ", " + std::to_string(found[1]) + ", " +
+                std::to_string(found[2]) + "), expected " + layout + " (theta_half, theta_diff, phi_diff) of the MERL layout");
+  if (size < expected)
+    throw Error(who + "truncated: " + std::to_string(size) + " bytes, a MERL file has " + std::to_string(expected));
+  if (size > expected)
+    throw Error(who + std::to_string(size - expected) + " bytes after the table (" + std::to_string(expected) +
+                " expected): not a MERL file");
+
+  MerlTable table;
+  table.name = displayName;
+  table.rgb.assign(3 * nodes, 0.0f);
+  std::vector<unsigned char> measured(nodes, 1);
+  const unsigned char* data = bytes + 12;
+  const std::size_t perTheta = std::size_t(dims.thetaD) * std::size_t(dims.phiD);
+  auto where = [&](int c, std::size_t n) {
+    return channelName(c) + " entry [theta_h " + std::to_string(n / perTheta) + ", theta_d " +
+           std::to_string(n / std::size_t(dims.phiD) % std::size_t(dims.thetaD)) + ", phi_d " +
+           std::to_string(n % std::size_t(dims.phiD)) + "]";
+  };
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t n = 0; n < nodes; ++n) {
+      double v;
+      std::memcpy(&v, data + (std::size_t(c) * nodes + n) * 8, 8);
+      if (!std::isfinite(v)) throw Error(who + where(c, n) + " is " + (std::isnan(v) ? "NaN" : "infinite"));
+      if (v < 0) {
+        measured[n] = 0;
+        continue;
+      }
+      double f = v * kMerlScale[c];
+      if (f > 1e30)
+        throw Error(who + where(c, n) + " = " + std::to_string(v) + " is too large (BRDF above 1e30 / sr)");
+      table.rgb[3 * n + std::size_t(c)] = float(f);
+    }
+  table.unmeasured = std::uint32_t(std::count(measured.begin(), measured.end(), 0));
+  if (!fillUnmeasured(table.rgb, measured, dims)) throw Error(who + "no entry is measured (every value is negative)");
+  return table;
+}
+
 BrdfParams loadMerl(const std::string& path, const std::string& displayName) {
   const std::string who = displayName + ": ";
   std::ifstream in(path, std::ios::binary | std::ios::ate);
@@ -121,61 +172,23 @@ BrdfParams loadMerl(const std::string& path, const std::string& displayName) {
                 " (90 x 90 x 180 x 3 doubles after a 12-byte header)");
   std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
   if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) throw Error(who + "cannot read the MERL file");
-  if (bytes.size() < 12)
-    throw Error(who + "truncated: " + std::to_string(bytes.size()) + " bytes, shorter than the 12-byte dimension header");
-  std::int32_t dims[3];
-  std::memcpy(dims, bytes.data(), 12);
-  if (dims[0] != kH || dims[1] != kD || dims[2] != kP)
-    throw Error(who + "dimension header (" + std::to_string(dims[0]) + ", " + std::to_string(dims[1]) + ", " +
-                std::to_string(dims[2]) + "), expected (90, 90, 180) (theta_half, theta_diff, phi_diff) of the MERL layout");
-  if (bytes.size() < kMerlFileBytes)
-    throw Error(who + "truncated: " + std::to_string(bytes.size()) + " bytes, a MERL file has " +
-                std::to_string(kMerlFileBytes));
-  if (bytes.size() > kMerlFileBytes)
-    throw Error(who + std::to_string(bytes.size() - kMerlFileBytes) + " bytes after the table (" +
-                std::to_string(kMerlFileBytes) + " expected): not a MERL file");
-
-  auto table = std::make_unique<MerlTable>();
-  table->name = displayName;
-  table->hash = fnv1a(bytes.data(), bytes.size());
-  {
+  auto paramsOf = [](std::size_t slot, std::uint64_t hash) {
+    BrdfParams p{};
+    p.v[0][MERL_SLOT] = float(slot);
+    p.v[0][MERL_HASH_LO] = float(hash & 0xffffff);
+    p.v[0][MERL_HASH_HI] = float((hash >> 24) & 0xffffff);
+    return p;
+  };
+  // The same content loaded before shares its slot (it passed every check then).
+  const std::uint64_t hash = fnv1a(bytes.data(), bytes.size());
+  if (bytes.size() == kMerlFileBytes) {
     std::lock_guard<std::mutex> lock(g_storeMutex);
     for (std::size_t s = 0; s < g_store.size(); ++s)
-      if (g_store[s]->hash == table->hash) {
-        BrdfParams p{};
-        p.v[0][MERL_SLOT] = float(s);
-        p.v[0][MERL_HASH_LO] = float(table->hash & 0xffffff);
-        p.v[0][MERL_HASH_HI] = float((table->hash >> 24) & 0xffffff);
-        return p;
-      }
+      if (g_store[s]->hash == hash) return paramsOf(s, hash);
   }
-  table->rgb.assign(MERL_TABLE_FLOATS, 0.0f);
-  std::vector<unsigned char> measured(MERL_NODES, 1);
-  const unsigned char* data = bytes.data() + 12;
-  for (int c = 0; c < 3; ++c)
-    for (std::size_t n = 0; n < MERL_NODES; ++n) {
-      double v;
-      std::memcpy(&v, data + (std::size_t(c) * MERL_NODES + n) * 8, 8);
-      if (!std::isfinite(v)) {
-        std::size_t i = n / (std::size_t(kD) * kP), j = n / kP % kD, k = n % kP;
-        throw Error(who + channelName(c) + " entry [theta_h " + std::to_string(i) + ", theta_d " + std::to_string(j) +
-                    ", phi_d " + std::to_string(k) + "] is " + (std::isnan(v) ? "NaN" : "infinite"));
-      }
-      if (v < 0) {
-        measured[n] = 0;
-        continue;
-      }
-      double f = v * kMerlScale[c];
-      if (f > 1e30) {
-        std::size_t i = n / (std::size_t(kD) * kP), j = n / kP % kD, k = n % kP;
-        throw Error(who + channelName(c) + " entry [theta_h " + std::to_string(i) + ", theta_d " + std::to_string(j) +
-                    ", phi_d " + std::to_string(k) + "] = " + std::to_string(v) + " is too large (BRDF above 1e30 / sr)");
-      }
-      table->rgb[3 * n + std::size_t(c)] = float(f);
-    }
-  table->unmeasured = std::uint32_t(std::count(measured.begin(), measured.end(), 0));
-  if (!fillUnmeasured(table->rgb, measured))
-    throw Error(who + "no entry is measured (every value is negative)");
+  auto table = std::make_unique<MerlTable>(decodeMerl(bytes.data(), bytes.size(), displayName));
+  table->hash = hash;
+  bytes = {};
   table->luminance.resize(MERL_NODES);
   for (std::size_t n = 0; n < MERL_NODES; ++n)
     table->luminance[n] = std::max(0.0f, luminance(vec3(table->rgb[3 * n], table->rgb[3 * n + 1], table->rgb[3 * n + 2])));
@@ -191,10 +204,7 @@ BrdfParams loadMerl(const std::string& path, const std::string& displayName) {
     throw Error(who + "more than " + std::to_string(MERL_MAX_TABLES) + " distinct measured tables in one run");
   std::uint32_t slot = std::uint32_t(g_store.size());
   g_merlTables[slot] = table->rgb.data();
-  BrdfParams p{};
-  p.v[0][MERL_SLOT] = float(slot);
-  p.v[0][MERL_HASH_LO] = float(table->hash & 0xffffff);
-  p.v[0][MERL_HASH_HI] = float((table->hash >> 24) & 0xffffff);
+  BrdfParams p = paramsOf(slot, table->hash);
   g_store.push_back(std::move(table));
   return p;
 }

@@ -27,6 +27,20 @@ struct MerlTable {
   std::uint32_t pyramidDims[8][3] = {};
 };
 
+// The dimensions (theta_half, theta_diff, phi_diff) a file must declare: the format's 90 x 90 x 180
+// for every table nusselt renders; decodeMerl accepts others so that a fuzzer can reach whole
+// small tables (tests/fuzz/fuzz_merl.cpp).
+struct MerlDims {
+  std::int32_t thetaH = std::int32_t(MERL_THETA_H_RES), thetaD = std::int32_t(MERL_THETA_D_RES), phiD = std::int32_t(MERL_PHI_D_RES);
+};
+
+// Checks and decodes the bytes of a MERL file declaring `dims`: the header, the size (12 bytes of
+// header and 3 x nodes doubles, nothing after), every entry finite and its BRDF at most 1e30;
+// scales the entries, fills the "not measured" (negative) ones (loadMerl) and returns the table's
+// name, unmeasured count and rgb (node order of `dims`, theta_half-major), without the
+// builder's bounds. Throws nusselt::Error naming `displayName` for the first problem found.
+MerlTable decodeMerl(const unsigned char* bytes, std::size_t size, const std::string& displayName, const MerlDims& dims = {});
+
 // Reads a MERL binary file (three int32 dimensions 90 90 180, then the red, green and blue tables
 // of doubles, theta_half-major) into the store and returns its parameter block. Entries < 0 are
 // "not measured": each such node takes the value of the nearest measured node along theta_d

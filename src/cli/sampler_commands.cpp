@@ -304,14 +304,14 @@ int benchPrecompute(const BenchArgs& a) {
     std::printf("\n");
     if (m.measured) {
       // The table itself: rgb floats on the GPU; the CPU keeps them, the node luminances and their
-      // max pyramid (the builder's bounds).
+      // maxima (pyramid, over phi_d: the builder's bounds).
       const MerlTable& mt = merlTable(p);
-      std::uint64_t cpu = (mt.rgb.size() + mt.luminance.size()) * sizeof(float);
+      std::uint64_t cpu = (mt.rgb.size() + mt.luminance.size() + mt.maxOverPhi.size()) * sizeof(float);
       for (const auto& level : mt.pyramid) cpu += level.size() * sizeof(float);
       std::printf("  %s: table %.1f KiB on the GPU (%u floats), %.1f KiB on the CPU; trees %.1f KiB; %u nodes not measured; "
-                  "%.2f M evaluations of f, %.2f s of CPU\n",
+                  "%.2f M evaluations of f, %.2f M boxes bounded, %.2f s of CPU\n",
                   name.c_str(), MERL_TABLE_FLOATS * 4 / 1024.0, unsigned(MERL_TABLE_FLOATS), cpu / 1024.0, s.bytes / 1024.0,
-                  mt.unmeasured, s.evaluations / 1e6, s.buildSeconds);
+                  mt.unmeasured, s.evaluations / 1e6, s.certifyBoxes / 1e6, s.buildSeconds);
     }
     std::fflush(stdout);
     sum += t.seconds;

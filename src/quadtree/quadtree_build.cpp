@@ -283,61 +283,115 @@ Interval cosRange(double p0, double p1) {
 }
 Interval sinRange(double p0, double p1) { return cosRange(p0 - M_PI / 2, p1 - M_PI / 2); }
 
-// Luminance of the interpolant at table coordinates (u_h, u_d, u_p) in double (brdf/merl.h's
-// merlLookup on the node luminances).
-double merlLumAt(const MerlTable& t, double uh, double ud, double up) {
-  uh = std::clamp(uh, 0.0, 89.0);
-  ud = std::clamp(ud, 0.0, 89.0);
-  up = std::fmod(up, 180.0);
-  if (up < 0) up += 180;
-  int i0 = std::min(int(uh), 88), j0 = std::min(int(ud), 88), k0 = std::min(int(up), 179);
-  int k1 = k0 + 1 == 180 ? 0 : k0 + 1;
-  double fi = uh - i0, fj = ud - j0, fk = up - k0;
-  auto n = [&](int i, int j, int k) { return double(t.luminance[(std::size_t(i) * 90 + std::size_t(j)) * 180 + std::size_t(k)]); };
-  auto lk = [&](int i, int j) { return n(i, j, k0) + fk * (n(i, j, k1) - n(i, j, k0)); };
-  double c0 = lk(i0, j0) + fj * (lk(i0, j0 + 1) - lk(i0, j0));
-  double c1 = lk(i0 + 1, j0) + fj * (lk(i0 + 1, j0 + 1) - lk(i0 + 1, j0));
-  return c0 + fi * (c1 - c0);
-}
-
 // The exact maximum of the interpolant over the u box (grid of box ends and nodes between), or,
-// for a box spanning more than 512 grid points, the largest node of the cells it meets.
+// for a box whose grid has more than kMerlGridMax points, the largest node of the cells it meets
+// (merlNodeMax). The grid is evaluated axis by axis, as merlLookup (brdf/merl.h) interpolates:
+// along phi_d at every node row the box meets, then along theta_d, then along theta_h.
+constexpr std::size_t kMerlGridMax = 4096;
 double merlBoxMax(const MerlTable& t, Interval uh, Interval ud, Interval up) {
   uh = {std::clamp(uh.lo, 0.0, 89.0), std::clamp(uh.hi, 0.0, 89.0)};
   ud = {std::clamp(ud.lo, 0.0, 89.0), std::clamp(ud.hi, 0.0, 89.0)};
   if (up.hi - up.lo >= 179) up = {0, 180};
-  auto axis = [](Interval a, std::vector<double>& out) {
-    out.clear();
-    out.push_back(a.lo);
-    for (double k = std::floor(a.lo) + 1; k < a.hi; k += 1) out.push_back(k);
-    out.push_back(a.hi);
+  // A coordinate of the grid: the lower node of its cell and the fraction towards the next.
+  struct At {
+    int n0;
+    double f;
   };
-  static thread_local std::vector<double> A, B, C;
+  auto axis = [](Interval a, std::vector<At>& out) {
+    out.clear();
+    auto add = [&](double u) {
+      int n = std::min(int(u), 88);
+      out.push_back({n, u - n});
+    };
+    add(a.lo);
+    for (double k = std::floor(a.lo) + 1; k < a.hi; k += 1) add(k);
+    add(a.hi);
+  };
+  static thread_local std::vector<At> A, B, C;
+  static thread_local std::vector<double> Tk, Tj;
   axis(uh, A);
   axis(ud, B);
-  if (up.hi - up.lo >= 179 && A.size() * B.size() <= 4096) {
+  if (up.hi - up.lo >= 179 && A.size() * B.size() <= kMerlGridMax) {
     // Every phi_d: the interpolant at (u_h, u_d) is at most the bilinear interpolation of the
     // nodes' maxima over phi_d, whose maximum over the box is on its grid.
     auto M = [&](int i, int j) { return double(t.maxOverPhi[std::size_t(i) * 90 + std::size_t(j)]); };
     double m = 0;
-    for (double a : A)
-      for (double b : B) {
-        int i0 = std::min(int(a), 88), j0 = std::min(int(b), 88);
-        double fi = a - i0, fj = b - j0;
-        double c0 = M(i0, j0) + fj * (M(i0, j0 + 1) - M(i0, j0)), c1 = M(i0 + 1, j0) + fj * (M(i0 + 1, j0 + 1) - M(i0 + 1, j0));
-        m = std::max(m, c0 + fi * (c1 - c0));
+    for (const At& a : A)
+      for (const At& b : B) {
+        const int i0 = a.n0, j0 = b.n0;
+        double c0 = M(i0, j0) + b.f * (M(i0, j0 + 1) - M(i0, j0)), c1 = M(i0 + 1, j0) + b.f * (M(i0 + 1, j0 + 1) - M(i0 + 1, j0));
+        m = std::max(m, c0 + a.f * (c1 - c0));
       }
     return m;
   }
-  axis(up, C);
-  if (A.size() * B.size() * C.size() > 512)
+  C.clear();
+  {
+    auto add = [&](double u) {
+      u = std::fmod(u, 180.0);
+      if (u < 0) u += 180;
+      int k = std::min(int(u), 179);
+      C.push_back({k, u - k});
+    };
+    add(up.lo);
+    for (double k = std::floor(up.lo) + 1; k < up.hi; k += 1) add(k);
+    add(up.hi);
+  }
+  const std::size_t nA = A.size(), nB = B.size(), nC = C.size();
+  if (nA * nB * nC > kMerlGridMax)
     return merlNodeMax(t, int(uh.lo), int(uh.hi) + 1, int(ud.lo), int(ud.hi) + 1, int(std::floor(up.lo)),
                        int(std::floor(up.hi)) + 1);
+  const int i0 = A.front().n0, j0 = B.front().n0;
+  const std::size_t ni = std::size_t(A.back().n0 - i0 + 2), nj = std::size_t(B.back().n0 - j0 + 2);
+  // Tk[(i, j), c]: along phi_d at node row (i0 + i, j0 + j).
+  Tk.resize(ni * nj * nC);
+  for (std::size_t i = 0; i < ni; ++i)
+    for (std::size_t j = 0; j < nj; ++j) {
+      const float* row = t.luminance.data() + ((std::size_t(i0) + i) * 90 + std::size_t(j0) + j) * 180;
+      double* out = &Tk[(i * nj + j) * nC];
+      for (std::size_t c = 0; c < nC; ++c) {
+        const int k0 = C[c].n0, k1 = k0 + 1 == 180 ? 0 : k0 + 1;
+        out[c] = double(row[k0]) + C[c].f * (double(row[k1]) - double(row[k0]));
+      }
+    }
+  // Tj[(i, b), c]: then along theta_d.
+  Tj.resize(ni * nB * nC);
+  for (std::size_t i = 0; i < ni; ++i)
+    for (std::size_t b = 0; b < nB; ++b) {
+      const double* lo = &Tk[(i * nj + std::size_t(B[b].n0 - j0)) * nC];
+      const double* hi = lo + nC;
+      double* out = &Tj[(i * nB + b) * nC];
+      for (std::size_t c = 0; c < nC; ++c) out[c] = lo[c] + B[b].f * (hi[c] - lo[c]);
+    }
+  // The maximum along theta_h.
   double m = 0;
-  for (double a : A)
-    for (double b : B)
-      for (double c : C) m = std::max(m, merlLumAt(t, a, b, c));
+  for (const At& a : A)
+    for (std::size_t b = 0; b < nB; ++b) {
+      const double* lo = &Tj[(std::size_t(a.n0 - i0) * nB + b) * nC];
+      const double* hi = lo + nB * nC;
+      for (std::size_t c = 0; c < nC; ++c) m = std::max(m, lo[c] + a.f * (hi[c] - lo[c]));
+    }
   return m;
+}
+
+// luminance(f(wi, wo)) of a measured table as the builder evaluates it: merlEval's coordinates
+// (the shared code) and its trilinear interpolation applied to the node luminances. Luminance is
+// linear, so this is the sampler's quadEvalLum up to float rounding (relative 1e-7: the
+// integrals and fits see no difference; the bounds are proven apart, with their own safety), at a
+// third of the table reads.
+float merlEvalLum(const MerlTable& t, vec3 wi, vec3 wo) {
+  if (wi.z <= 0.0f || wo.z <= 0.0f) return 0.0f;
+  const vec3 u = merlCoordinates(wi, wo);
+  const std::uint32_t i0 = std::min(std::uint32_t(u.x), MERL_THETA_H_RES - 2u), j0 = std::min(std::uint32_t(u.y), MERL_THETA_D_RES - 2u);
+  const std::uint32_t k0 = std::min(std::uint32_t(u.z), MERL_PHI_D_RES - 1u), k1 = k0 + 1u == MERL_PHI_D_RES ? 0u : k0 + 1u;
+  const float fi = u.x - float(i0), fj = u.y - float(j0), fk = u.z - float(k0);
+  auto row = [&](std::uint32_t i, std::uint32_t j) {
+    const float* r = t.luminance.data() + (std::size_t(i) * MERL_THETA_D_RES + j) * MERL_PHI_D_RES;
+    return r[k0] + fk * (r[k1] - r[k0]);
+  };
+  const float c00 = row(i0, j0), c01 = row(i0, j0 + 1u), c10 = row(i0 + 1u, j0), c11 = row(i0 + 1u, j0 + 1u);
+  const float c0 = c00 + fj * (c01 - c00), c1 = c10 + fj * (c11 - c10);
+  const float f = c0 + fi * (c1 - c0);
+  return std::isfinite(f) ? std::max(f, 0.0f) : 0.0f;
 }
 
 // An upper bound of luminance(f(w, v)) over the w in the box x * y * z (disc coordinates and
@@ -381,8 +435,11 @@ double merlRegionBound(const MerlTable& t, vec3 v, Interval x, Interval y, Inter
       Interval cp = divPos(Interval{vz, vz} - z, den);
       cp = {std::clamp(cp.lo, -1.0, 1.0), std::clamp(cp.hi, -1.0, 1.0)};
       double p0 = std::acos(cp.hi), p1 = std::acos(cp.lo);
-      // Near the plane of incidence rho is small and the cosine loose; sin(phi_d) = v.x w.y /
-      // (rho sin(theta_d)) in [0, sMax] keeps phi_d within asin(sMax) of 0 or pi.
+      // Near the plane of incidence the cosine's enclosure is loose (it reaches +-1, and acos is
+      // steep there); sin(phi_d) = v.x w.y / (rho sin(theta_d)) in [sMin, sMax] keeps phi_d within
+      // asin(sMax) of 0 or pi, and at least asin(sMin) away from both. Without the second, a
+      // region a degree off the plane counts the nodes on it, which hold the horizon's very large
+      // values for a table of ward (f ~ 1/sqrt(cos)): leaves there went to the depth cap.
       Interval sd = sqrtI({(1 - d.hi) / 2, (1 - d.lo) / 2});
       if (sd.lo > 1e-12) {
         double sMax = vx * y.hi / (rho.lo * sd.lo);
@@ -391,6 +448,12 @@ double merlRegionBound(const MerlTable& t, vec3 v, Interval x, Interval y, Inter
           if (p0 >= M_PI / 2) p0 = std::max(p0, M_PI - a);
           else if (p1 <= M_PI / 2) p1 = std::min(p1, a);
         }
+      }
+      const double sMin = std::min(1.0, vx * y.lo / (rho.hi * sd.hi));
+      if (sMin > 0) {
+        const double a = std::asin(sMin);
+        p0 = std::max(p0, a);
+        p1 = std::min(p1, M_PI - a);
       }
       up = {p0 * 180 / M_PI - pad, p1 * 180 / M_PI + pad};
     }
@@ -429,9 +492,13 @@ class Builder {
   std::vector<RulePoint> m_rx, m_ry;
   double m_aEst = 0;
 
+  // luminance(f(w, v)) (merl: merlEvalLum).
+  double evalLum(vec3 w) const {
+    return m_merl ? merlEvalLum(*m_merl, w, m_v) : quadEvalLum(m_model, m_params, w, m_v);
+  }
   double eval(double x, double y, double c, double phi, double w, CellResult& r) {
     ++m_evals;
-    double f = quadEvalLum(m_model, m_params, vec3(float(x), float(y), float(c)), m_v);
+    double f = evalLum(vec3(float(x), float(y), float(c)));
     if (f > r.fmax) r.fmax = f;
     if (f > 0) r.anyPositive = true;
     r.pts.push_back({float(x), float(y), float(c), float(phi), float(f), w});
@@ -472,7 +539,7 @@ class Builder {
   Frame frameOf(const Cell& c, PolarBox* box) const;
   Envelope fit(const Cell& c, const Frame& fr, const CellResult& all, const std::vector<Pt>& quad);
   void polish(const Cell& c, const Frame& fr, CellResult& all, Envelope& env, int lattice);
-  void certify(const Frame& fr, Envelope& env);
+  bool certify(const Frame& fr, Envelope& env, double giveUp);
   double tolerance(double q) const { return std::max(m_s.relTol * std::abs(q), m_s.absTol * m_aEst); }
 };
 
@@ -944,7 +1011,7 @@ void Builder::polish(const Cell& cell, const Frame& fr, CellResult& all, Envelop
     if (!(t1 >= 0 && t1 <= 1 && t2 >= 0 && t2 <= 1) ||
         !proposalPoint(fr.kind, fr.a0, fr.a1, fr.b0, fr.b1, cell.a0, cell.a1, cell.b0, cell.b1, t1, t2, x, y, c))
       return -1.0;
-    double f = quadEvalLum(m_model, m_params, vec3(float(x), float(y), float(c)), m_v);
+    double f = evalLum(vec3(float(x), float(y), float(c)));
     ++m_evals;
     all.pts.push_back({float(x), float(y), float(c), NAN, float(f), -1});
     return f / envAt(t1, t2, c);
@@ -1002,25 +1069,28 @@ void Builder::polish(const Cell& cell, const Frame& fr, CellResult& all, Envelop
 // proposal coordinates; a box is proven when the envelope's minimum over it (at a corner: the
 // exponential is monotone along each axis) is at least the exact bound of f over it
 // (merlRegionBound); unproven boxes are split four ways (down to 1/64 of the domain), and the
-// envelope is scaled by the largest bound / minimum left.
-void Builder::certify(const Frame& fr, Envelope& env) {
+// envelope is scaled by the largest bound / minimum left (the growth).
+// Boxes are taken largest ratio bound / minimum first: a box whose ratio is at most the growth
+// found so far is proven by the grown envelope (the growth never decreases), so once the first
+// box at the finest level sets the growth, the boxes left are proven without splitting them (a
+// sub-box's bound is at most its box's, its envelope minimum at least as large). The growth is
+// the same as that of a search of every box. Returns false, leaving the envelope unproven, as
+// soon as the growth exceeds giveUp (the leaf would then be split anyway).
+bool Builder::certify(const Frame& fr, Envelope& env, double giveUp) {
   const double safety = 1.001;  // float rounding of the shared evaluation and of the envelope
   struct Box {
     double a0, a1, b0, b1;
     int depth;
+    double ratio;  // bound of f over the box / the envelope's minimum over it
   };
-  std::vector<Box> stack{{0, 1, 0, 1, 0}};
-  double worst = 0;
-  while (!stack.empty()) {
-    Box b = stack.back();
-    stack.pop_back();
+  auto ratioOf = [&](Box& b) {
     ++m_certifyBoxes;
     Interval x, y, z;
     if (fr.kind == QT_PROPOSAL_SQUARE) {
       x = {fr.a0 + b.a0 * (fr.a1 - fr.a0), fr.a0 + b.a1 * (fr.a1 - fr.a0)};
       y = {fr.b0 + b.b0 * (fr.b1 - fr.b0), fr.b0 + b.b1 * (fr.b1 - fr.b0)};
       Interval r2 = sq(x) + sq(y);
-      if (r2.lo >= 1) continue;  // outside the disc: never sampled
+      if (r2.lo >= 1) return 0.0;  // outside the disc: never sampled
       z = sqrtI({1 - std::min(r2.hi, 1.0), 1 - r2.lo});
     } else {
       double u0 = fr.a0 * fr.a0, u1 = fr.a1 * fr.a1;
@@ -1032,25 +1102,45 @@ void Builder::certify(const Frame& fr, Envelope& env) {
       y = r * sinRange(p0, p1);
     }
     double bound = safety * merlRegionBound(*m_merl, m_v, x, y, z);
-    if (bound <= 0) continue;
+    if (bound <= 0) return 0.0;
+    // e > 0 everywhere (A > 0, |k| <= 40), so the ratio is finite
     double e = env.A * std::exp(std::min(env.k1 * (b.a0 - 0.5), env.k1 * (b.a1 - 0.5)) +
                                 std::min(env.k2 * (b.b0 - 0.5), env.k2 * (b.b1 - 0.5)));
-    if (bound <= e) continue;
-    if (b.depth < 6 && m_certifyBoxes < (1u << 30)) {
-      double am = 0.5 * (b.a0 + b.a1), bm = 0.5 * (b.b0 + b.b1);
-      stack.push_back({b.a0, am, b.b0, bm, b.depth + 1});
-      stack.push_back({am, b.a1, b.b0, bm, b.depth + 1});
-      stack.push_back({b.a0, am, bm, b.b1, b.depth + 1});
-      stack.push_back({am, b.a1, bm, b.b1, b.depth + 1});
+    return e > 0 ? bound / e : INFINITY;
+  };
+  auto lower = [](const Box& p, const Box& q) { return p.ratio < q.ratio; };
+  std::vector<Box> heap;
+  Box root{0, 1, 0, 1, 0, 0};
+  root.ratio = ratioOf(root);
+  double worst = 1;  // the growth: boxes at or below it are proven
+  if (root.ratio > worst) heap.push_back(root);
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), lower);
+    Box b = heap.back();
+    heap.pop_back();
+    if (b.ratio <= worst) continue;
+    if (b.depth >= 6 || m_certifyBoxes >= (1u << 30)) {
+      worst = b.ratio;
+      if (worst > giveUp) return false;
       continue;
     }
-    worst = std::max(worst, e > 0 ? bound / e : INFINITY);
+    double am = 0.5 * (b.a0 + b.a1), bm = 0.5 * (b.b0 + b.b1);
+    Box ch[4] = {{b.a0, am, b.b0, bm, b.depth + 1, 0}, {am, b.a1, b.b0, bm, b.depth + 1, 0},
+                 {b.a0, am, bm, b.b1, b.depth + 1, 0}, {am, b.a1, bm, b.b1, b.depth + 1, 0}};
+    for (Box& c : ch) {
+      c.ratio = ratioOf(c);
+      if (c.ratio > worst) {
+        heap.push_back(c);
+        std::push_heap(heap.begin(), heap.end(), lower);
+      }
+    }
   }
-  if (worst > 1) {  // e > 0 everywhere (A > 0, |k| <= 40), so worst is finite
+  if (worst > 1) {
     env.A *= worst;
     env.V *= worst;
     env.trialV *= worst;
   }
+  return true;
 }
 
 struct Item {
@@ -1164,9 +1254,23 @@ Tree Builder::build() {
       }
     }
     if (leaf && mass > 0) {
-      polish(cell, fr, all, env, accepts(mass, env) ? 0 : kLowLeafLattice);
-      if (m_merl) certify(fr, env);
-      if (!capped && !(accepts(mass, env) || tailOk(mass, env))) {
+      // merl: no search between the points; certify proves the envelope (or grows it) exactly
+      // (6% fewer evaluations of f and 1% fewer leaves on the ward table).
+      if (!m_merl) polish(cell, fr, all, env, accepts(mass, env) ? 0 : kLowLeafLattice);
+      bool proven = true;
+      if (m_merl) {
+        // The largest growth with which the leaf is kept (accepted, or a tail leaf; any at the
+        // cap), a little above so that only clear failures give up: a leaf that fails the split
+        // rule already is split without a proof.
+        double giveUp = INFINITY;
+        if (!capped && !(mass < 1e-12 * m_aEst)) {
+          giveUp = m_s.nMax * mass / env.V;
+          if (mass < m_s.tailTol * m_aEst) giveUp = std::max(giveUp, 16 * mass / env.trialV);
+          giveUp *= 1 + 1e-9;
+        }
+        proven = giveUp >= 1 && certify(fr, env, giveUp);
+      }
+      if (!proven || (!capped && !(accepts(mass, env) || tailOk(mass, env)))) {
         leaf = false;  // the envelope had to grow: split after all
         running -= mass - sumq;
       }
@@ -1235,6 +1339,7 @@ Tree Builder::build() {
   }
   tree.stats.nodes = std::uint32_t(tree.nodes.size());
   tree.stats.evaluations = m_evals;
+  tree.stats.certifyBoxes = m_certifyBoxes;
   return tree;
 }
 

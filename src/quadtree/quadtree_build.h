@@ -37,6 +37,7 @@ struct TreeStats {
   std::uint32_t maxDepth = 0;
   double minAcceptance = 1.0;      // min over non-tail leaves of the acceptance I / V
   std::uint64_t evaluations = 0;
+  std::uint64_t certifyBoxes = 0;  // merl: boxes whose exact bound the proof of the envelopes computed
 };
 
 // One tree in local indices (node 0 is the root unless root is a leaf): child links index

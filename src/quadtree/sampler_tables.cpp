@@ -319,6 +319,7 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
         st.maxDepth = std::max(st.maxDepth, tr.stats.maxDepth);
         st.minAcceptance = std::min(st.minAcceptance, tr.stats.minAcceptance);
         st.evaluations += tr.stats.evaluations;
+        st.certifyBoxes += tr.stats.certifyBoxes;
         st.buildSeconds += u.seconds[t];
       }
       u.built.clear();

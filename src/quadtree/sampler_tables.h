@@ -33,6 +33,7 @@ struct MaterialStats {
   double minAcceptance = 1;
   std::uint64_t bytes = 0;
   std::uint64_t evaluations = 0;
+  std::uint64_t certifyBoxes = 0;  // merl: boxes bounded by the proof of the envelopes (TreeStats)
   bool cacheHit = false;
   double buildSeconds = 0;  // CPU seconds summed over its trees (0 on a cache hit)
 };

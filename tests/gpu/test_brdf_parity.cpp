@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 #include <random>
 
 #include "../support/test_support.h"
@@ -48,40 +47,12 @@ std::vector<std::pair<vec3, vec3>> directionPairs(std::uint32_t seed, int n) {
 
 }  // namespace
 
+// The bound at each pair: test::BrdfParityKernel (4x the C++ value's change under 4-ulp moves of
+// the directions, plus 16 ulps).
 TEST(BrdfParity, CpuAndGpuEvaluateTheSameFunction) {
   const int n = 10000;
-  auto pairs = directionPairs(1234, n);
-  vk::Context& ctx = test::context();
-  vk::Buffer pairBuf = vk::createBuffer(ctx, n * 32, 0, true, "pairs");
-  vk::Buffer paramBuf = vk::createBuffer(ctx, sizeof(BrdfParams), 0, true, "params");
-  vk::Buffer resultBuf = vk::createBuffer(ctx, n * 16, 0, true, "results");
-  for (int i = 0; i < n; ++i) {
-    float* p = static_cast<float*>(pairBuf.mapped) + 8 * i;
-    for (int c = 0; c < 3; ++c) {
-      p[c] = pairs[i].first[c];
-      p[4 + c] = pairs[i].second[c];
-    }
-  }
-  struct Push {
-    std::uint64_t pairs, params, result;
-    std::uint32_t count, pad;
-    std::uint64_t measured;  // merl's tables (tests/gpu/test_merl_gpu.cpp); none here
-  } push{pairBuf.address, paramBuf.address, resultBuf.address, std::uint32_t(n), 0, 0};
-
-  // Tolerance: the two builds round differently (fused multiply-adds, LLVM's vs glibc's exp, pow,
-  // sin...), by a few ulps per operation; what that does to f depends on how sensitive f is at
-  // the pair (pow(x, 10000) multiplies the relative error of x by 10^4; tan near 90 degrees, a
-  // shadowing boundary...). So the bound at each pair is measured on the CPU build itself: the
-  // largest change of f when the directions' components move by up to 4 ulps (6 perturbations),
-  // and the GPU value must lie within 4x that change plus 16 ulps of f:
-  //   |gpu - cpu| <= 4 * sensitivity + 16 ulp * |cpu| + 1e-30.
+  test::BrdfParityKernel kernel(directionPairs(1234, n));
   const float ulp = std::ldexp(1.0f, -23);
-  std::mt19937 prng(99);
-  std::uniform_int_distribution<int> step(-4, 4);
-  auto perturb = [&](vec3 w) {
-    for (int c = 0; c < 3; ++c) w[c] *= 1.0f + step(prng) * ulp;
-    return w;
-  };
   int failedSets = 0;
   for (const ModelSpec& model : allModels()) {
     if (model.delta) continue;
@@ -89,48 +60,19 @@ TEST(BrdfParity, CpuAndGpuEvaluateTheSameFunction) {
     for (auto& v : model.variants) sets.push_back(v);
     for (auto& [setName, values] : sets) {
       BrdfParams params = packParams(model, values, model.name + "/" + setName);
-      std::memcpy(paramBuf.mapped, &params, sizeof params);
-      test::runKernel("eval_brdf", {model.id}, &push, sizeof push, n);
-      const float* gpu = static_cast<const float*>(resultBuf.mapped);
-      double worstRel = 0, worstRatio = 0;
-      int worstIndex = -1, outside = 0;
-      for (int i = 0; i < n; ++i) {
-        vec3 cpu = shared::brdfEval(model.id, params, pairs[i].first, pairs[i].second);
-        vec3 sensitivity(0.0f);
-        for (int k = 0; k < 6; ++k) {
-          vec3 moved = shared::brdfEval(model.id, params, perturb(pairs[i].first), perturb(pairs[i].second));
-          for (int c = 0; c < 3; ++c) sensitivity[c] = std::max(sensitivity[c], std::fabs(moved[c] - cpu[c]));
-        }
-        bool bad = false;
-        for (int c = 0; c < 3; ++c) {
-          double a = gpu[4 * i + c], b = cpu[c];
-          ASSERT_TRUE(std::isfinite(a)) << model.name << "/" << setName << " pair " << i << ": GPU value " << a;
-          double bound = 4.0 * sensitivity[c] + 16.0 * ulp * std::fabs(b) + 1e-30;
-          double diff = std::fabs(a - b);
-          double scale = std::max(std::fabs(a), std::fabs(b));
-          if (scale > 1e-30) worstRel = std::max(worstRel, diff / scale);
-          if (diff / bound > worstRatio) {
-            worstRatio = diff / bound;
-            worstIndex = i;
-          }
-          bad = bad || diff > bound;
-        }
-        outside += bad;
-      }
+      test::BrdfParityKernel::Result r = kernel.run(model.id, params);
       std::printf("[parity] %-18s %-16s worst relative difference %.3g (%.1f ulp), worst |diff|/bound %.3f\n",
-                  model.name.c_str(), setName.c_str(), worstRel, worstRel / ulp, worstRatio);
-      if (outside) {
+                  model.name.c_str(), setName.c_str(), r.worstRel, r.worstRel / ulp, r.worstRatio);
+      EXPECT_EQ(r.nonFinite, 0) << model.name << "/" << setName << ": GPU values that are NaN or infinite";
+      if (r.outside) {
         ++failedSets;
-        vec3 wi = pairs[worstIndex].first, wo = pairs[worstIndex].second;
-        ADD_FAILURE() << model.name << "/" << setName << ": " << outside << " of " << n
-                      << " pairs outside the bound; worst at pair " << worstIndex << " wi (" << wi.x << ", " << wi.y << ", "
-                      << wi.z << ") wo (" << wo.x << ", " << wo.y << ", " << wo.z << "): |diff|/bound " << worstRatio;
+        vec3 wi = kernel.pairs()[std::size_t(r.worstIndex)].first, wo = kernel.pairs()[std::size_t(r.worstIndex)].second;
+        ADD_FAILURE() << model.name << "/" << setName << ": " << r.outside << " of " << n
+                      << " pairs outside the bound; worst at pair " << r.worstIndex << " wi (" << wi.x << ", " << wi.y << ", "
+                      << wi.z << ") wo (" << wo.x << ", " << wo.y << ", " << wo.z << "): |diff|/bound " << r.worstRatio;
       }
     }
   }
   EXPECT_EQ(failedSets, 0);
-  vk::destroyBuffer(ctx, pairBuf);
-  vk::destroyBuffer(ctx, paramBuf);
-  vk::destroyBuffer(ctx, resultBuf);
   EXPECT_EQ(test::validationMessages(), 0u);
 }

@@ -3,8 +3,6 @@
 // trial failures, and parity with the CPU (same random numbers: same directions and pdfs).
 #include <gtest/gtest.h>
 
-#include <map>
-
 #include "../support/test_support.h"
 #include "../unit/test_quadtree_chi2.h"
 
@@ -16,21 +14,14 @@ TEST(QuadtreeGpu, ChiSquareAndParity) {
   std::vector<qttest::Case> cases = qttest::caseMatrix();
   const double cellAlpha = qttest::suiteAlpha();
   const std::uint32_t n = qttest::kSamples;
-  std::map<std::string, quadtree::SamplerTables> built;
+  qttest::TableCache tables;
   int failures = 0;
   std::uint64_t violations = 0, trialFailures = 0;
   double gpuSeconds = 0;
   for (const qttest::Case& c : cases) {
     const ModelSpec* m = findModel(c.model);
     BrdfParams p = qttest::caseParams(c);
-    std::string key = c.model + (c.hard ? "/hard" : "/typical");
-    auto it = built.find(key);
-    if (it == built.end()) {
-      built.clear();  // cases come grouped by material: keep one set of tables at a time
-      std::vector<std::uint32_t> idx;
-      it = built.emplace(key, quadtree::buildSamplerTables({{m->id, p}}, qttest::testSettings(), idx)).first;
-    }
-    const quadtree::SamplerTables& t = it->second;
+    const quadtree::SamplerTables& t = tables.get(c.model + (c.hard ? "/hard" : "/typical"), m->id, p);
     vec3 v = qttest::knownDirection(c);
     quadtree::SampleBatch g = quadtree::sampleGpu(ctx, t, 0, m->id, p, v, n, 777u);
     gpuSeconds += g.seconds;
@@ -44,11 +35,7 @@ TEST(QuadtreeGpu, ChiSquareAndParity) {
     // Parity: the CPU with the same random numbers draws the same directions (up to float
     // differences of the two compilers, which can flip an acceptance: a small fraction).
     quadtree::SampleBatch cpu = quadtree::sampleCpu(t, 0, m->id, p, v, 2000, 777u);
-    int same = 0;
-    for (int i = 0; i < 2000; ++i) {
-      vec3 a(g.wPdf[i]), b(cpu.wPdf[i]);
-      if (length(a - b) < 1e-4f && std::abs(g.wPdf[i].w - cpu.wPdf[i].w) <= 1e-3f * cpu.wPdf[i].w + 1e-6f) ++same;
-    }
+    int same = qttest::sameSamples(g, cpu, 2000);
     std::printf("%-48s p=%.3g chi2=%.1f dof=%d gpu %.3f s, parity %d/2000\n", c.name().c_str(), r.pValue, r.chi2, r.dof,
                 g.seconds, same);
     EXPECT_GE(same, 1980) << c.name();

@@ -1,7 +1,9 @@
 #include "test_support.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -77,6 +79,73 @@ Rendered render(const Scene& scene, const RenderSettings& settings) {
   Renderer r(context(), scene, s);
   r.render(s.spp);
   return {r.image(true), r.stats(), r.summary()};
+}
+
+BrdfParityKernel::BrdfParityKernel(std::vector<std::pair<glm::vec3, glm::vec3>> pairs, std::uint64_t measured)
+    : m_pairs(std::move(pairs)), m_measured(measured) {
+  vk::Context& ctx = context();
+  const std::size_t n = m_pairs.size();
+  m_pairBuf = vk::createBuffer(ctx, n * 32, 0, true, "pairs");
+  m_paramBuf = vk::createBuffer(ctx, sizeof(shared::BrdfParams), 0, true, "params");
+  m_resultBuf = vk::createBuffer(ctx, n * 16, 0, true, "results");
+  for (std::size_t i = 0; i < n; ++i) {
+    float* p = static_cast<float*>(m_pairBuf.mapped) + 8 * i;
+    for (int c = 0; c < 3; ++c) {
+      p[c] = m_pairs[i].first[c];
+      p[4 + c] = m_pairs[i].second[c];
+    }
+  }
+}
+
+BrdfParityKernel::~BrdfParityKernel() {
+  vk::Context& ctx = context();
+  for (vk::Buffer* b : {&m_pairBuf, &m_paramBuf, &m_resultBuf}) vk::destroyBuffer(ctx, *b);
+}
+
+BrdfParityKernel::Result BrdfParityKernel::run(std::uint32_t model, const shared::BrdfParams& gpuParams,
+                                                const shared::BrdfParams& params) {
+  const int n = int(m_pairs.size());
+  struct Push {
+    std::uint64_t pairs, params, result;
+    std::uint32_t count, pad;
+    std::uint64_t measured;  // merl's tables
+  } push{m_pairBuf.address, m_paramBuf.address, m_resultBuf.address, std::uint32_t(n), 0, m_measured};
+  std::memcpy(m_paramBuf.mapped, &gpuParams, sizeof gpuParams);
+  runKernel("eval_brdf", {model}, &push, sizeof push, std::uint32_t(n));
+  const float* gpu = static_cast<const float*>(m_resultBuf.mapped);
+  const float ulp = std::ldexp(1.0f, -23);
+  auto perturb = [&](glm::vec3 w) {
+    for (int c = 0; c < 3; ++c) w[c] *= 1.0f + m_step(m_prng) * ulp;
+    return w;
+  };
+  Result r;
+  for (int i = 0; i < n; ++i) {
+    const glm::vec3 cpu = shared::brdfEval(model, params, m_pairs[std::size_t(i)].first, m_pairs[std::size_t(i)].second);
+    glm::vec3 sensitivity(0.0f);
+    for (int k = 0; k < 6; ++k) {
+      glm::vec3 moved = shared::brdfEval(model, params, perturb(m_pairs[std::size_t(i)].first), perturb(m_pairs[std::size_t(i)].second));
+      for (int c = 0; c < 3; ++c) sensitivity[c] = std::max(sensitivity[c], std::fabs(moved[c] - cpu[c]));
+    }
+    bool bad = false;
+    for (int c = 0; c < 3; ++c) {
+      const double a = gpu[4 * i + c], b = cpu[c];
+      if (!std::isfinite(a)) {
+        ++r.nonFinite;
+        bad = true;
+        continue;
+      }
+      const double bound = 4.0 * sensitivity[c] + 16.0 * ulp * std::fabs(b) + 1e-30;
+      const double diff = std::fabs(a - b), scale = std::max(std::fabs(a), std::fabs(b));
+      if (scale > 1e-30) r.worstRel = std::max(r.worstRel, diff / scale);
+      if (diff / bound > r.worstRatio) {
+        r.worstRatio = diff / bound;
+        r.worstIndex = i;
+      }
+      bad = bad || diff > bound;
+    }
+    r.outside += bad;
+  }
+  return r;
 }
 
 void runKernel(const std::string& name, const std::vector<std::uint32_t>& specialization, const void* push,

@@ -2,8 +2,12 @@
 // binary (validation layer on when NUSSELT_VALIDATION=1, as ctest sets it), rendering a scene to
 // an image with its per-pixel variance, and statistical comparisons.
 #pragma once
+#include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "brdf/registry.h"
 #include "io/image.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
@@ -36,6 +40,42 @@ Rendered render(const Scene& scene, const RenderSettings& settings);
 // threads, with the given specialization constants, and waits for it.
 void runKernel(const std::string& name, const std::vector<std::uint32_t>& specialization, const void* push,
                std::uint32_t pushBytes, std::uint32_t invocations);
+
+// The GLSL build of brdfEval (kernel eval_brdf) against the C++ build at fixed direction pairs,
+// one model and parameter block per run; `measured` is the device address of the merl tables (0:
+// none). The two builds round differently (fused multiply-adds, LLVM's vs glibc's exp, pow,
+// sin...), by a few ulps per operation; what that does to f depends on how sensitive f is at the
+// pair (pow(x, 10000) multiplies the relative error of x by 10^4; tan near 90 degrees, a
+// shadowing boundary...). So the bound at each pair is measured on the CPU build itself: the
+// largest change of f when the directions' components move by up to 4 ulps (6 perturbations, from
+// one generator seeded 99 for the object's life), and the GPU value must lie within 4x that
+// change plus 16 ulps of f:
+//   |gpu - cpu| <= 4 * sensitivity + 16 ulp * |cpu| + 1e-30.
+class BrdfParityKernel {
+ public:
+  explicit BrdfParityKernel(std::vector<std::pair<glm::vec3, glm::vec3>> pairs, std::uint64_t measured = 0);
+  ~BrdfParityKernel();
+  BrdfParityKernel(const BrdfParityKernel&) = delete;
+  BrdfParityKernel& operator=(const BrdfParityKernel&) = delete;
+  struct Result {
+    int outside = 0;     // pairs with a channel outside the bound
+    int nonFinite = 0;   // GPU values that are NaN or infinite
+    int worstIndex = -1; // the pair of the largest |diff| / bound
+    double worstRel = 0, worstRatio = 0;  // largest relative difference, largest |diff| / bound
+  };
+  Result run(std::uint32_t model, const shared::BrdfParams& params) { return run(model, params, params); }
+  // The GPU evaluates with `gpuParams`, the C++ build with `cpuParams` (merl: the table's slot in
+  // the device buffer and in the process's store differ).
+  Result run(std::uint32_t model, const shared::BrdfParams& gpuParams, const shared::BrdfParams& cpuParams);
+  const std::vector<std::pair<glm::vec3, glm::vec3>>& pairs() const { return m_pairs; }
+
+ private:
+  std::vector<std::pair<glm::vec3, glm::vec3>> m_pairs;
+  vk::Buffer m_pairBuf, m_paramBuf, m_resultBuf;
+  std::uint64_t m_measured;
+  std::mt19937 m_prng{99};
+  std::uniform_int_distribution<int> m_step{-4, 4};
+};
 
 // Two-sided p-value of a standard normal z.
 double normalPValue(double z);

@@ -2,11 +2,11 @@
 // code path: tabulateMerl + writeMerlFile) and the measured sampler's case matrix, shared by
 // tests/unit/test_merl.cpp (CPU) and tests/gpu/test_merl_gpu.cpp (GPU).
 #pragma once
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -29,6 +29,9 @@ inline std::vector<Source> sources() {
   const ModelSpec* ts = findModel("torrance_sparrow");
   return {{"lambert05", "lambert", {{"rho", ParamValue::num(0.5)}}}, {"glossy", "torrance_sparrow", typicalParams(*ts)}};
 }
+// A sharp table: ward's typical set (1992 normalisation, f ~ 1/sqrt(cos) at the horizon), whose
+// nodes next to the horizon are up to 1e7 times their neighbours (docs/measured.md, Limits).
+inline Source wardSource() { return {"ward", "ward", typicalParams(*findModel("ward"))}; }
 
 // A folder for this process's files (35 MB each), removed at exit.
 inline std::string tempDir() {
@@ -85,6 +88,22 @@ inline double suiteAlpha() { return 0.01 / (2.0 * double(caseMatrix().size())); 
 inline vec3 knownDirection(double thetaDeg) {
   double th = thetaDeg * M_PI / 180;
   return vec3(float(std::sin(th)), 0.0f, float(std::cos(th)));
+}
+
+// The chi-square test of one case for samples drawn on the CPU or the GPU from tables `t`: bins
+// from an independent CPU pilot run (seed 99), expected counts from the pdf; the checks of every
+// sampler test (no bound violations or trial failures, the bins' probabilities summing to 1, the
+// p-value at least the suite's level). Returns the result for the caller's line.
+inline qttest::Chi2Result checkChiSquare(const Case& c, const quadtree::SamplerTables& t, const BrdfParams& p,
+                                         const quadtree::SampleBatch& samples) {
+  const vec3 v = knownDirection(c.thetaDeg);
+  quadtree::SampleBatch pilot = quadtree::sampleCpu(t, 0, MODEL_MERL, p, v, qttest::kPilotSamples, 99u);
+  qttest::Chi2Result r = qttest::quadChiSquare(t, 0, MODEL_MERL, p, v, pilot.wPdf, samples.wPdf);
+  EXPECT_EQ(samples.boundViolations, 0u) << c.name();
+  EXPECT_EQ(samples.trialFailures, 0u) << c.name();
+  EXPECT_NEAR(r.expectedTotal, 1.0, 2e-4) << c.name();
+  EXPECT_GE(r.pValue, suiteAlpha()) << c.name() << "\n" << r.dump;
+  return r;
 }
 
 }  // namespace nusselt::merltest

@@ -359,6 +359,39 @@ inline Chi2Result quadChiSquare(const quadtree::SamplerTables& t, std::uint32_t 
   return chiSquare(bins, prob, samples);
 }
 
+// Sampler tables of one material at a time (testSettings), built on first use: the case
+// matrices come grouped by material, so each is built once and only one is held.
+class TableCache {
+ public:
+  const quadtree::SamplerTables& get(const std::string& key, std::uint32_t model, const BrdfParams& p) {
+    if (!m_built || key != m_key) {
+      std::vector<std::uint32_t> idx;
+      m_tables = quadtree::buildSamplerTables({{model, p}}, testSettings(), idx);
+      m_key = key;
+      m_built = true;
+    }
+    return m_tables;
+  }
+
+ private:
+  std::string m_key;
+  bool m_built = false;
+  quadtree::SamplerTables m_tables;
+};
+
+// Parity of the GPU sampler with the CPU one: how many of the first n samples both drew alike
+// from the same random numbers (direction within 1e-4, pdf within 1e-3 relative); float
+// differences of the two compilers can flip an acceptance, a small fraction.
+inline int sameSamples(const quadtree::SampleBatch& gpu, const quadtree::SampleBatch& cpu, int n) {
+  int same = 0;
+  for (int i = 0; i < n; ++i) {
+    vec3 a(gpu.wPdf[std::size_t(i)]), b(cpu.wPdf[std::size_t(i)]);
+    if (length(a - b) < 1e-4f && std::abs(gpu.wPdf[std::size_t(i)].w - cpu.wPdf[std::size_t(i)].w) <= 1e-3f * cpu.wPdf[std::size_t(i)].w + 1e-6f)
+      ++same;
+  }
+  return same;
+}
+
 inline vec3 knownDirection(const Case& c) {
   double t = c.thetaDeg * M_PI / 180, ph = c.phiDeg * M_PI / 180;
   return vec3(float(std::sin(t) * std::cos(ph)), float(std::sin(t) * std::sin(ph)), float(std::cos(t)));
