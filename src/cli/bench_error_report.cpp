@@ -129,16 +129,22 @@ struct Run {
 
 struct PointRow {
   std::string model, preset, strategy, integrand, thetaText;
-  double theta = 0, z = 0, ns = 0, t3 = 0;
+  double theta = 0, z = 0, ns = 0, t3 = 0;  // theta: read to check it is a number; shown as thetaText
   bool agree = true, extrapolated = false, analyticIsCosine = false;
   double failed = 0, tabBytes = 0;
 };
 
+// The rows of the CSV file at `path` as Row, each filled by fill(csv, row index, row).
+template <class Row, class Fill>
+std::vector<Row> readRows(const std::string& path, const char* writtenBy, Fill fill) {
+  Csv c = readCsv(path, writtenBy);
+  std::vector<Row> out(c.rows.size());
+  for (std::size_t i = 0; i < c.rows.size(); ++i) fill(c, i, out[i]);
+  return out;
+}
+
 std::vector<PointRow> readPoint(const std::string& path) {
-  Csv c = readCsv(path, "experiment 1");
-  std::vector<PointRow> out;
-  for (std::size_t i = 0; i < c.rows.size(); ++i) {
-    PointRow r;
+  return readRows<PointRow>(path, "experiment 1", [&](const Csv& c, std::size_t i, PointRow& r) {
     r.model = c.text(i, "model");
     r.preset = c.text(i, "preset");
     r.strategy = c.text(i, "strategy");
@@ -156,37 +162,28 @@ std::vector<PointRow> readPoint(const std::string& path) {
     r.analyticIsCosine = c.number(i, "analytic_is_cosine") != 0;
     r.failed = c.number(i, "failed_samples");
     r.tabBytes = c.number(i, "tab_bytes_per_table");
-    out.push_back(r);
-  }
-  return out;
+  });
 }
 
 struct SceneRow {
   std::string experiment, scene, variant, rerunZ;
-  double spp = 0, relMse = 0, seconds = 0, build = 0, z = 0, nonFinite = 0;
+  double relMse = 0, seconds = 0, z = 0, nonFinite = 0;
   bool agree = true;
   double cost() const { return relMse * seconds; }
 };
 
 std::vector<SceneRow> readScenes(const std::string& path) {
-  Csv c = readCsv(path, "experiment 2");
-  std::vector<SceneRow> out;
-  for (std::size_t i = 0; i < c.rows.size(); ++i) {
-    SceneRow r;
+  return readRows<SceneRow>(path, "experiment 2", [](const Csv& c, std::size_t i, SceneRow& r) {
     r.experiment = c.text(i, "experiment");
     r.scene = c.text(i, "scene");
     r.variant = c.text(i, "variant");
     r.rerunZ = c.text(i, "rerun_z");
-    r.spp = c.number(i, "spp");
     r.relMse = c.number(i, "rel_mse");
     r.seconds = c.number(i, "seconds");
-    r.build = c.number(i, "build_seconds");
     r.z = c.number(i, "z_mean");
     r.agree = c.number(i, "agree") != 0;
     r.nonFinite = c.number(i, "nonfinite");
-    out.push_back(r);
-  }
-  return out;
+  });
 }
 
 // ---- Model families -----------------------------------------------------------------------------
@@ -244,11 +241,15 @@ std::vector<Case> makeCases(const std::vector<PointRow>& rows, const std::vector
     auto si = std::find(strategies.begin(), strategies.end(), r.strategy);
     if (si != strategies.end()) cases[it->second].s[si - strategies.begin()] = &r;
   }
+  // A time that is not a number counts as never reaching the error; ties go to the first strategy.
+  auto faster = [](const PointRow* a, const PointRow* b) {
+    return !std::isnan(a->t3) && (std::isnan(b->t3) || a->t3 < b->t3);
+  };
   for (Case& c : cases) {
     for (std::size_t i = 0; i < c.s.size(); ++i) {
       if (!c.s[i]) continue;
-      if (c.winner < 0 || c.s[i]->t3 < c.s[c.winner]->t3) c.winner = int(i);
-      if (i > 0 && (c.bestOther < 0 || c.s[i]->t3 < c.s[c.bestOther]->t3)) c.bestOther = int(i);
+      if (c.winner < 0 || faster(c.s[i], c.s[c.winner])) c.winner = int(i);
+      if (i > 0 && (c.bestOther < 0 || faster(c.s[i], c.s[c.bestOther]))) c.bestOther = int(i);
     }
     if (c.s[0] && c.bestOther >= 0) {
       double q = c.s[0]->t3, b = c.s[c.bestOther]->t3;
