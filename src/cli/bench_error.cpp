@@ -12,13 +12,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <functional>
-#include <map>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -701,10 +697,13 @@ int benchError(const ErrorArgs& a) {
   int disagree = 0;
   for (const Curve& c : curves) disagree += std::abs(c.z) > zPoint;
   for (const SceneRow& r : rows) disagree += !r.agree;
+  std::string written = "run.csv";
+  if (!a.noPoint) written += ",point.csv,point_summary.csv,point-*.png";
+  if (!rows.empty()) written += ",scenes.csv,scene-*";
   std::printf("bench error: %zu point curves, %zu scene renders in %.1f s; %d estimates disagree with their reference; "
-              "wrote %s/{run.csv,point.csv,point_summary.csv,scenes.csv,results.md,*.png}%s%s\n",
-              curves.size(), rows.size(), total, disagree, a.out.c_str(), a.report.empty() ? "" : " and ",
-              a.report.c_str());
+              "wrote %s/{%s,results.md}%s%s\n",
+              curves.size(), rows.size(), total, disagree, a.out.c_str(), written.c_str(),
+              a.report.empty() ? "" : " and ", a.report.c_str());
   return kExitOk;
 }
 
@@ -743,7 +742,9 @@ void registerBenchError(CLI::App& bench, CommandRunner& run) {
     if (ea->quick) cl += " --quick";
     for (CLI::Option* o : e->get_options())
       if (o->count() && o->get_name() != "--quick" && o->get_name() != "--help") {
-        for (const std::string& r : o->results()) cl += " " + o->get_name() + " " + r;
+        if (o->get_expected_max() == 0) cl += " " + o->get_name();  // a flag (--no-point): no value
+        else
+          for (const std::string& r : o->results()) cl += " " + o->get_name() + " " + r;
       }
     ea->commandLine = cl;
     run = [ea]() { return benchError(*ea); };
