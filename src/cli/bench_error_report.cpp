@@ -335,7 +335,7 @@ void writeFamilyTable(std::ostringstream& o, const std::vector<const Case*>& cas
       if (std::isfinite(mean[i]) && (best < 0 || mean[i] < mean[best])) best = int(i);
     o << "| " << model << " | " << preset << " |";
     for (std::size_t i = 0; i < strategies.size(); ++i) {
-      std::string cell = fmtTime(mean[i]) + (star[i] && std::isfinite(mean[i]) ? "*" : "");
+      std::string cell = (star[i] && std::isfinite(mean[i]) ? "~" : "") + fmtTime(mean[i]);
       if (int(i) == best) cell = "**" + cell + "**";
       if (asCos[i]) cell += " (=cosine)";
       o << " " << cell << " |";
@@ -432,22 +432,26 @@ void writePointSummary(std::ostringstream& o, const std::vector<PointRow>& rows,
 // The discussion's table: experiment 1 per model family.
 void writeFamilySummary(std::ostringstream& o, const PointCases& p, const std::vector<std::string>& strategies) {
   o << "| family | cases | quadtree fastest | fastest, all strategies | quadtree / best other (geo. mean) | "
-       "quadtree's worst case |\n|---|---|---|---|---|---|\n";
+       "quadtree's best case | quadtree's worst case |\n|---|---|---|---|---|---|---|\n";
   for (const std::string& fam : p.families) {
     std::vector<const Case*> sel = p.envOf(fam);
     GeoMean g;
-    const Case* worst = nullptr;
+    const Case *best = nullptr, *worst = nullptr;
     int qw = 0;
     for (const Case* c : sel) {
       g.add(c->ratio);
       qw += c->winner == 0;
-      if (std::isfinite(c->ratio) && (!worst || c->ratio > worst->ratio)) worst = c;
+      if (!std::isfinite(c->ratio)) continue;
+      if (!best || c->ratio < best->ratio) best = c;
+      if (!worst || c->ratio > worst->ratio) worst = c;
     }
     o << "| " << fam << " | " << sel.size() << " | " << qw << " | " << winCounts(sel, strategies) << " | "
-      << fmtRatio(g.value()) << " | ";
-    if (worst)
-      o << caseName(*worst) << ": " << fmtRatio(worst->ratio) << " x " << strategies[worst->bestOther] << "'s time";
-    o << " |\n";
+      << fmtRatio(g.value()) << " |";
+    for (const Case* c : {best, worst}) {
+      if (c) o << " " << caseName(*c) << ": " << fmtRatio(c->ratio) << " x " << strategies[c->bestOther] << "'s time";
+      o << " |";
+    }
+    o << "\n";
   }
   o << "\n";
 }
@@ -457,7 +461,7 @@ void writePointFamilies(std::ostringstream& o, const Run& run, const std::vector
   o << "## Experiment 1: one shading point, by model family\n\n";
   writeSettings(o, run, rows);
   o << "Each cell: the time to reach a relative error of 1e-3 in the environment integrand, geometric mean over "
-       "the angles (`*`: at least one of them extrapolated beyond 2^"
+       "the angles (`~`: at least one of them extrapolated beyond 2^"
     << run.get("max_log2") << " samples, `-`: not reached); **bold**: the smallest in the row; `(=cosine)`: the "
        "model has no analytic sampler and `analytic` falls back to cosine. `fastest (angles)`: the fastest strategy "
        "at each angle; `quadtree / best other`: geometric mean over the angles of the quadtree's time over the "
