@@ -99,5 +99,26 @@ SHARED_FN vec4 textureAtHit(TEXEL_BUFFER texels, GpuTexture t, GpuTriTexcoords c
   return textureLookup(texels, t, triangleTexcoord(c, set, b1, b2));
 }
 
+// The surface directions of a texture's axes under its transform (KHR_texture_transform), for
+// the normal map's tangent frame. A map's x axis lies along increasing u of the coordinates it is
+// read with, its y axis along s times increasing v (s = +1 or -1: the frame's handedness against
+// the coordinates). In: (t, b) the unit directions of those axes for the untransformed coordinates
+// (t along dS/du, b along s dS/dv) and lu = |dS/du|, lv = |dS/dv| on the triangle. Out: in (t, b)
+// the (unnormalised) directions dS/du' and s dS/dv' of the transformed coordinates, from
+// (u, v) = A^-1 ((u', v') - offset). The identity leaves lu t and lv b; a singular transform
+// (no defined axes) leaves (t, b) unchanged.
+SHARED_FN void textureTransformFrame(GpuTexture tex, float lu, float lv, float s, INOUT(vec3) t, INOUT(vec3) b) {
+  float a = tex.transform0.x;  // u' = a u + c v + ...
+  float bb = tex.transform0.y; // v' = bb u + d v + ...
+  float c = tex.transform0.z;
+  float d = tex.transform0.w;
+  float det = a * d - bb * c;
+  if (!(abs(det) > 1e-20f) || !isFinite(det)) return;
+  vec3 su = lu * t;      // dS/du
+  vec3 sv = lv * s * b;  // dS/dv
+  t = (d * su - bb * sv) / det;      // dS/du' = (A^-1)_00 dS/du + (A^-1)_10 dS/dv
+  b = s * (a * sv - c * su) / det;   // s dS/dv' = s ((A^-1)_01 dS/du + (A^-1)_11 dS/dv)
+}
+
 SHARED_END
 #endif

@@ -86,6 +86,29 @@ vec3 normalMapped(uint material, uint tri, float b1, float b2, vec3 ns, vec3 ngF
   if (!(tl > 1e-6f)) return ns;
   t /= tl;
   vec3 bt = (t0.w < 0.0f ? -1.0f : 1.0f) * cross(ns, t);
+  // A texture transform with a linear part (rotation, scale) turns the map's axes on the surface:
+  // the frame follows them (textureTransformFrame), with the triangle's |dS/du|, |dS/dv| of the
+  // map's coordinate set and the frame's handedness against them; then orthonormal about ns again.
+  GpuTexture map = g.textures.v[tex];
+  if (map.transform0 != vec4(1.0f, 0.0f, 0.0f, 1.0f)) {
+    GpuTriangle T = g.triangles.v[tri];
+    GpuTriTexcoords tc = g.texcoords.v[tri];
+    uint set = (map.info.w & TEXTURE_FLAG_SET1) != 0u ? 1u : 0u;
+    vec2 w0 = triangleTexcoord(tc, set, 0.0f, 0.0f);
+    vec2 d1 = triangleTexcoord(tc, set, 1.0f, 0.0f) - w0;
+    vec2 d2 = triangleTexcoord(tc, set, 0.0f, 1.0f) - w0;
+    float r = d1.x * d2.y - d2.x * d1.y;
+    vec3 du = (T.e1.xyz * d2.y - T.e2.xyz * d1.y) / r;
+    vec3 dv = (T.e2.xyz * d1.x - T.e1.xyz * d2.x) / r;
+    if (r != 0.0f && isFinite(r)) {
+      textureTransformFrame(map, length(du), length(dv), dot(bt, dv) < 0.0f ? -1.0f : 1.0f, t, bt);
+      t -= dot(t, ns) * ns;
+      tl = length(t);
+      if (!(tl > 1e-6f)) return ns;
+      t /= tl;
+      bt = (dot(bt, cross(ns, t)) < 0.0f ? -1.0f : 1.0f) * cross(ns, t);
+    }
+  }
   vec3 c = sceneTexture(tex, tri, b1, b2).xyz * 2.0f - 1.0f;
   vec3 n = c.x * scale * t + c.y * scale * bt + c.z * ns;
   float nl = length(n);

@@ -334,6 +334,64 @@ TEST(TexturesRender, ConstantNormalMapShadesAsTheTiltedPlane) {
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
+// Normal maps under KHR_texture_transform: the transform turns the map's axes on the surface, and
+// the tangent frame must turn with them. Two quads with the same constant normal map (tilted 30
+// degrees towards the map's +x) and a rotating transform, u' = cos(r) u - sin(r) v,
+// v' = sin(r) u + cos(r) v: left r = 90 degrees with the usual coordinates (v runs at half
+// speed: |dS/dv| = 2 |dS/du|), right r = 30 degrees with |dS/du| = |dS/dv|. The map's x axis lies
+// along dS/du' and its y axis along -dS/dv' (the image's up, as the bitangent b = +y is here), from
+// (u, v) = A^-1 (u', v'): left x -> +y and y -> -x, right the frame turned by 30 degrees. Without
+// the compensation the left quad would shade as tilted towards +x. Exact, as the test above.
+TEST(TexturesRender, RotatedNormalMapTurnsItsFrame) {
+  Scene s;
+  const float tilt = 0.5235988f;
+  const glm::vec3 texel(std::sin(tilt), 0.0f, std::cos(tilt));
+  glm::ivec3 code;
+  for (int k = 0; k < 3; ++k) code[k] = int(std::lround((texel[k] + 1.0f) * 0.5f * 255.0f));
+  const int image = addImage(s, 1, 1, [&](int, int) { return glm::ivec4(code, 255); });
+  const glm::vec3 c = glm::vec3(code) / 255.0f * 2.0f - 1.0f;
+  const float rot[2] = {1.5707963f, 0.5235988f};
+  const float vSpeed[2] = {0.5f, 1.0f};  // v = vSpeed (1 - y)
+  glm::vec3 expectedNormal[2], unturned[2];
+  for (int q = 0; q < 2; ++q) {
+    Material m = lambert(q == 0 ? "turned90" : "turned30", 0.5);
+    m.normalTexture = nearest(image, ColorSpace::Linear);
+    const float cr = std::cos(rot[q]), sr = std::sin(rot[q]);
+    m.normalTexture.transform = glm::mat3x2(glm::vec2(cr, sr), glm::vec2(-sr, cr), glm::vec2(0.0f));
+    s.materials.push_back(m);
+    const float x0 = q == 0 ? -1.0f : 0.0f;
+    glm::vec3 A(x0, -1, 0), B(x0 + 1, -1, 0), C(x0 + 1, 1, 0), D(x0, 1, 0);
+    test::addQuad(s, A, B, C, D, std::uint32_t(q));
+    for (glm::vec3 p : {A, B, C, A, C, D}) {
+      s.texcoords0.push_back(glm::vec2(p.x - x0, vSpeed[q] * (1 - p.y)));
+      s.tangents.push_back(glm::vec4(1, 0, 0, 1));
+    }
+    // dS/du = +x, dS/dv = -y / vSpeed; the columns of A^-1 give dS/du' and dS/dv'.
+    const glm::mat2 inv = glm::inverse(glm::mat2(glm::vec2(cr, sr), glm::vec2(-sr, cr)));
+    const glm::vec3 dSdu(1, 0, 0), dSdv(0, -1.0f / vSpeed[q], 0);
+    const glm::vec3 xAxis = glm::normalize(inv[0][0] * dSdu + inv[0][1] * dSdv);
+    const glm::vec3 yAxis = -glm::normalize(inv[1][0] * dSdu + inv[1][1] * dSdv);
+    expectedNormal[q] = glm::normalize(c.x * xAxis + c.y * yAxis + c.z * glm::vec3(0, 0, 1));
+    unturned[q] = glm::normalize(c);
+  }
+  const glm::vec3 l = glm::normalize(glm::vec3(0.5f, -0.6f, 1.0f));
+  PunctualLight sun;
+  sun.type = LightType::Directional;
+  sun.direction = -l;
+  sun.intensity = glm::vec3(2.0f);
+  s.lights.push_back(sun);
+  lookDown(s, 1.0f, 1.0f);
+  test::Rendered r = test::render(s, exactSettings(1, 3));
+  double value[2];
+  for (int q = 0; q < 2; ++q) {
+    value[q] = 0.5 / M_PI * 2.0 * std::max(0.0f, glm::dot(expectedNormal[q], l));
+    const double without = 0.5 / M_PI * 2.0 * std::max(0.0f, glm::dot(unturned[q], l));
+    EXPECT_GT(std::fabs(value[q] - without), 0.05 * without) << "quad " << q << ": the turn must change the image";
+  }
+  EXPECT_EQ(pixelMisses(r.image, [&](int px, int, int) { return value[px < 8 ? 0 : 1]; }, 1e-4, 0.0), 0);
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
 namespace {
 
 // The traversals this device has: the GLSL BVH, and ray queries when offered.
