@@ -57,13 +57,31 @@ uint alphaHashStep(uint h, uint v) {
 // counts. OPAQUE: always. MASK: alpha >= alphaCutoff. BLEND: with probability alpha (stochastic
 // transparency), decided by a hash of the ray and the triangle, so a render is a function of its
 // seed. alpha = baseColorFactor.a x the base-colour texture's alpha at the hit.
-bool alphaPasses(uint tri, float b1, float b2, vec3 origin, vec3 dir) {
-  uint material = g.shading.v[tri].info.x;
-  if ((g.materials.v[material].info.y & MATERIAL_ALPHA) == 0u) return true;
+// alpha = baseColorFactor.a x the base-colour texture's alpha of a MASK or BLEND material at
+// barycentrics (b1, b2) of triangle tri.
+float alphaAt(uint material, uint tri, float b1, float b2) {
   GpuMaterialTextures T = g.materialTextures.v[material];
   float alpha = T.baseColorFactor.w;
   if (T.alpha.y != INVALID_INDEX)
     alpha *= textureAtHit(texelBuffer(), g.textures.v[T.alpha.y], g.texcoords.v[tri], b1, b2).w;
+  return alpha;
+}
+
+// The expected coverage of a point: 1 for opaque materials, MASK 0 or 1 by the cutoff, BLEND
+// alpha (the probability that alphaPasses lets a ray stop there). Light sampling weights an
+// emitter's point by it, so that it agrees with what rays that meet the emitter see.
+float alphaCoverage(uint material, uint tri, float b1, float b2) {
+  if ((g.materials.v[material].info.y & MATERIAL_ALPHA) == 0u) return 1.0f;
+  float alpha = alphaAt(material, tri, b1, b2);
+  if (g.materialTextures.v[material].alpha.x == ALPHA_MASK) return alpha >= g.materialTextures.v[material].factors.w ? 1.0f : 0.0f;
+  return clamp(alpha, 0.0f, 1.0f);
+}
+
+bool alphaPasses(uint tri, float b1, float b2, vec3 origin, vec3 dir) {
+  uint material = g.shading.v[tri].info.x;
+  if ((g.materials.v[material].info.y & MATERIAL_ALPHA) == 0u) return true;
+  GpuMaterialTextures T = g.materialTextures.v[material];
+  float alpha = alphaAt(material, tri, b1, b2);
   if (T.alpha.x == ALPHA_MASK) return alpha >= T.factors.w;
   uint h = alphaHashStep(tri * 0x9e3779b9u, floatBitsToUint(origin.x));
   h = alphaHashStep(h, floatBitsToUint(origin.y));
@@ -237,6 +255,11 @@ bool sampleLight(vec3 x, float uSelect, vec2 uPoint, out LightSample ls) {
     uint material = g.shading.v[tri].info.x;
     vec3 Le = g.materials.v[material].emission.xyz;
     if (HAS_TEXTURES) Le = texturedEmission(material, Le, tri, b.x, b.y);
+#if NUSSELT_SCENE_FEATURES && NUSSELT_ALPHA
+    // An emitter with alpha (MASK or BLEND): the sampled point emits as much as rays that meet the
+    // emitter there see on average (a cut-out point nothing, a BLEND point alpha of it).
+    if (HAS_TEXTURES) Le *= alphaCoverage(material, tri, b.x, b.y);
+#endif
     ls.value = Le / ls.pdf;
     ls.dist = dist;
     return ls.pdf > 0.0f && isFinite(ls.pdf);
