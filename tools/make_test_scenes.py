@@ -21,7 +21,8 @@
                  along x, metallic along z), a back wall with a baseColor texture on TEXCOORD_1
                  (LINEAR, MIRRORED_REPEAT) and a lamp with an emissive stripe texture (sRGB).
                  The PNGs are generated here (zlib) and embedded as data URIs.
-  glass_slab.gltf  a slab of glass (KHR_materials_transmission 1, KHR_materials_ior 1.5, metallic 0)
+  glass_slab.gltf  a slab of glass (KHR_materials_transmission 1, KHR_materials_ior 1.5, metallic 0,
+                 KHR_materials_volume thickness 0.2: a refracting volume, not thin-walled)
                  between z = 0.2 and 0.4 (its top and bottom faces, outward normals) over an
                  emitter of radiance 1 at z = 0 facing +z; camera above, looking down. Seen
                  through the slab at normal incidence the emitter converges to (1 - R) / (1 + R)
@@ -419,9 +420,12 @@ def glass_slab():
     b = Builder()
     b.use("KHR_materials_transmission")
     b.use("KHR_materials_ior")
+    b.use("KHR_materials_volume")
+    # The volume's thickness makes the slab refract (without it glTF's transmission is thin-walled).
     glass = b.pbr_material("glass", {"metallicFactor": 0.0, "roughnessFactor": 0.0},
                            extensions={"KHR_materials_transmission": {"transmissionFactor": 1.0},
-                                       "KHR_materials_ior": {"ior": 1.5}})
+                                       "KHR_materials_ior": {"ior": 1.5},
+                                       "KHR_materials_volume": {"thicknessFactor": 0.2}})
     lamp = b.material("lamp", 0.0, emission=(1.0, 1.0, 1.0))
     b.quad("lamp", [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], lamp)
     b.quad("top", [[-1, -1, 0.4], [1, -1, 0.4], [1, 1, 0.4], [-1, 1, 0.4]], glass)

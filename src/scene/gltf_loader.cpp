@@ -1307,23 +1307,29 @@ class Converter {
           m.attenuationColor[k] = unit(a.Get(k).GetNumberAsDouble(), f + ".attenuationColor[" + str(k) + "]");
         }
       }
-      notRenderedYet("KHR_materials_volume");
+      // Its presence (thicknessFactor > 0) makes the transmission refract (transmissiveMaterial);
+      // the attenuation inside is not rendered yet.
+      if (std::isfinite(m.attenuationDistance)) notRenderedYet("KHR_materials_volume attenuation");
     }
   }
 
   // KHR_materials_transmission as smooth transmission (docs/scenes.md, "Transmission"): a combined
-  // material, gltf_pbr with weight 1 - w and the smooth dielectric of index ior (clamped to the
+  // material, gltf_pbr with weight 1 - w and a smooth dielectric of index ior (clamped to the
   // model's [0.1, 10]) with weight w = transmissionFactor x (1 - metallic): the dielectric's
   // Fresnel reflection and the gltf_pbr component's reflection together reflect as gltf_pbr
   // alone, and the gltf_pbr diffuse lobe is scaled by 1 - w, as the extension's mix of diffuse and
-  // transmission does. w = 1: the dielectric alone.
+  // transmission does. w = 1: the dielectric alone. The dielectric refracts (`dielectric`) when
+  // KHR_materials_volume gives the mesh a thickness (thicknessFactor > 0); otherwise the surface is
+  // thin-walled, as the extension defines, and light passes straight through (`thin_dielectric`).
   void transmissiveMaterial(Material& m, const std::string& context) {
     const float w = m.transmissionFactor * (1.0f - m.metallicFactor);
     if (!(w > 0.0f)) return;
-    BrdfParams glass = packParams(*findModel("dielectric"), {{"eta", ParamValue::num(std::min(m.ior, 10.0f))}},
+    const bool thin = !m.hasVolume || !(m.thicknessFactor > 0.0f);
+    const ModelSpec& glassModel = *findModel(thin ? "thin_dielectric" : "dielectric");
+    BrdfParams glass = packParams(glassModel, {{"eta", ParamValue::num(std::min(m.ior, 10.0f))}},
                                   context + " (transmission)");
     if (w >= 1.0f) {
-      m.model = MODEL_DIELECTRIC;
+      m.model = glassModel.id;
       m.params = glass;
       return;
     }
@@ -1332,7 +1338,7 @@ class Converter {
     base.weight = 1.0f - w;
     base.params = m.params;
     MaterialComponent clear;
-    clear.model = MODEL_DIELECTRIC;
+    clear.model = glassModel.id;
     clear.weight = w;
     clear.params = glass;
     m.components = {base, clear};

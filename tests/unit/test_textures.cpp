@@ -478,7 +478,7 @@ TEST(GltfTextures, AlphaSidednessTransmissionIorVolume) {
   EXPECT_FLOAT_EQ(m.thicknessFactor, 0.02f);
   EXPECT_FLOAT_EQ(m.attenuationDistance, 0.5f);
   EXPECT_FLOAT_EQ(m.attenuationColor.y, 0.5f);
-  EXPECT_TRUE(hasWarning(s, "read but not rendered yet: KHR_materials_volume, transmissionTexture ("));
+  EXPECT_TRUE(hasWarning(s, "read but not rendered yet: KHR_materials_volume attenuation, transmissionTexture ("));
   // glTF's default metallicFactor 1: a metal does not transmit, the material stays gltf_pbr.
   EXPECT_EQ(m.model, MODEL_GLTF_PBR);
   EXPECT_FALSE(m.combined());
@@ -514,15 +514,18 @@ TEST(GltfTextures, AlphaSidednessTransmissionIorVolume) {
   EXPECT_HAS(errorWith(R"({"normalTexture": {"index": 0, "scale": 1e300}})"), "normalTexture.scale");
 }
 
-// KHR_materials_transmission renders as smooth transmission: gltf_pbr with weight 1 - w plus the
+// KHR_materials_transmission renders as smooth transmission: gltf_pbr with weight 1 - w plus a
 // dielectric of index ior with weight w = transmissionFactor x (1 - metallic); w = 1: the
-// dielectric alone. Neither extension is then named in the "not rendered" warning.
+// dielectric alone. Neither extension is then named in the "not rendered" warning. With
+// KHR_materials_volume's thickness the dielectric refracts (dielectric); without, the surface is
+// thin-walled (thin_dielectric), as the extension defines.
 TEST(GltfTextures, TransmissionBecomesTheDielectric) {
   Json j = texturedQuad();
-  j["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior"};
+  j["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"};
   j["materials"][0] = Json::parse(R"({"name": "frosted", "pbrMetallicRoughness": {"metallicFactor": 0.2,
     "roughnessFactor": 0.3}, "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.75},
-                                           "KHR_materials_ior": {"ior": 1.33}}})");
+                                           "KHR_materials_ior": {"ior": 1.33},
+                                           "KHR_materials_volume": {"thicknessFactor": 0.1}}})");
   Scene s = loadJson(j);
   const Material& m = s.materials[0];
   ASSERT_EQ(m.components.size(), 2u);
@@ -534,11 +537,22 @@ TEST(GltfTextures, TransmissionBecomesTheDielectric) {
   EXPECT_FLOAT_EQ(m.components[1].params.v[DIELECTRIC_ETA / 4][DIELECTRIC_ETA % 4], 1.33f);
   EXPECT_FALSE(hasWarning(s, "read but not rendered yet"));
   j["materials"][0] = Json::parse(R"({"name": "glass", "pbrMetallicRoughness": {"metallicFactor": 0},
-    "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1}}})");
+    "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+                   "KHR_materials_volume": {"thicknessFactor": 0.1}}})");
   const Material g = loadJson(j).materials[0];
   EXPECT_FALSE(g.combined());
   EXPECT_EQ(g.model, MODEL_DIELECTRIC);
   EXPECT_FLOAT_EQ(g.params.v[DIELECTRIC_ETA / 4][DIELECTRIC_ETA % 4], 1.5f);
+  // Thin-walled: no volume, or a volume of thickness 0.
+  for (const char* volume : {"", R"(, "KHR_materials_volume": {"thicknessFactor": 0})"}) {
+    j["materials"][0] = Json::parse(std::string(R"({"name": "pane", "pbrMetallicRoughness": {"metallicFactor": 0},
+      "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.5}, "KHR_materials_ior": {"ior": 1.7})") +
+                                    volume + "}}");
+    const Material t = loadJson(j).materials[0];
+    ASSERT_EQ(t.components.size(), 2u) << volume;
+    EXPECT_EQ(t.components[1].model, MODEL_THIN_DIELECTRIC) << volume;
+    EXPECT_FLOAT_EQ(t.components[1].params.v[THIN_DIELECTRIC_ETA / 4][THIN_DIELECTRIC_ETA % 4], 1.7f);
+  }
 }
 
 TEST(GltfTextures, ImageSourcesBufferViewDataUriAndExternalFile) {

@@ -32,6 +32,7 @@
 #include "dielectric.h"
 #include "gltf_pbr.h"
 #include "merl.h"
+#include "thin_dielectric.h"
 
 // X(id, NAME, fn): MODEL_<NAME> = id; <NAME>_DELTA, <NAME>_ANALYTIC and the functions <fn>Eval,
 // <fn>Spec, ... come from the model's header.
@@ -56,7 +57,8 @@
   X(17u, MIRROR, mirror)                   \
   X(18u, DIELECTRIC, dielectric)           \
   X(19u, GLTF_PBR, gltfPbr)                \
-  X(20u, MERL, merl)
+  X(20u, MERL, merl)                       \
+  X(21u, THIN_DIELECTRIC, thinDielectric)
 
 // The models the dispatch switches below and in analytic_sampling.h contain: all of them, or
 // only one in a shade module built for a single model (CMakeLists.txt: -DNUSSELT_SHADE_MODEL_ID,
