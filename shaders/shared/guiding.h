@@ -9,6 +9,7 @@
 #define NUSSELT_GUIDING_H
 #include "guiding_layout.h"
 #include "rng.h"
+#include "mass_descent.h"
 
 #ifdef __cplusplus
 SHARED_BEGIN
@@ -117,60 +118,23 @@ SHARED_FN float guideDirPdf(GuideView G, uint root, vec3 d) {
   return guideSquarePdf(G, root, guideDirectionToSquare(d)) * NUSSELT_INV_4PI;
 }
 
-// Child of a node by its masses with the uniform number u in [0, 1), which is rescaled to the
-// chosen child's share (one number serves several levels). A child whose interval is empty in
-// floats is never chosen; when rounding puts u x total at or past the total, the heaviest child
-// is taken. share = the chosen child's mass / the node's (0: the node has no mass).
-SHARED_FN uint guidePickChild(vec4 m, INOUT(float) u, OUT(float) share) {
-  float total = m.x + m.y + m.z + m.w;
-  share = 0.0f;
-  if (!(total > 0.0f)) return 0u;
-  float t = u * total;
-  float e1 = m.x;
-  float e2 = m.x + m.y;
-  float e3 = m.x + m.y + m.z;
-  uint c;
-  float below;
-  if (t < e1) { c = 0u; below = 0.0f; }
-  else if (t < e2) { c = 1u; below = e1; }
-  else if (t < e3) { c = 2u; below = e2; }
-  else if (t < total) { c = 3u; below = e3; }
-  else {
-    c = 0u;
-    if (m.y > m[c]) c = 1u;
-    if (m.z > m[c]) c = 2u;
-    if (m.w > m[c]) c = 3u;
-    below = t - m[c];
-  }
-  u = clamp((t - below) / m[c], 0.0f, NUSSELT_ONE_MINUS_EPS);
-  share = m[c] / total;
-  return c;
-}
-
 // Draws a unit direction d (world) with density guideDirPdf from the quadtree rooted at `root`:
-// a cell by descent in proportion to the masses (uDescent, rescaled at each level; once the
-// path's probability falls below 2^-10 a fresh number from the guide's stream of rngKey = (pixel,
-// sample, dimension, seed) takes over, so that a cell far below 2^-24 of the total keeps its
-// odds), then a uniform point of the cell (uCell). False when the tree has no mass.
+// a cell by descent in proportion to the masses (mass_descent.h: uDescent, rescaled at each level;
+// its fresh numbers come from the guide's stream of rngKey = (pixel, sample, dimension, seed)),
+// then a uniform point of the cell (uCell). False when the tree has no mass.
 SHARED_FN bool guideDirSample(GuideView G, uint root, float uDescent, vec2 uCell, uvec4 rngKey, OUT(vec3) d) {
   d = vec3(0.0f, 0.0f, 1.0f);
   uint node = root;
   float x0 = 0.0f;
   float y0 = 0.0f;
   float size = 1.0f;
-  float u = uDescent;
-  float pathShare = 1.0f;
+  MassDescent m = massDescentStart(uDescent);
+  uvec4 stream = uvec4(rngKey.x, rngKey.y, (rngKey.z & 0xffffu) | RNG_GUIDE_STREAM, rngKey.w);
   for (uint depth = 0u; depth <= GUIDE_MAX_DIR_DEPTH; ++depth) {
     GuideDirNode N = GUIDE_DIR(G, node);
-    if (pathShare < 1.0f / 1024.0f) {
-      uvec4 h = pcg4d(uvec4(rngKey.x, rngKey.y, (rngKey.z & 0xffffu) | RNG_GUIDE_STREAM, rngKey.w + depth));
-      u = float(h.x >> 8u) * (1.0f / 16777216.0f);
-      pathShare = 1.0f;
-    }
     float share;
-    uint c = guidePickChild(N.mass, u, share);
+    uint c = massDescendStep(N.mass, stream, m, share);
     if (!(share > 0.0f)) return false;
-    pathShare *= share;
     size *= 0.5f;
     if ((c & 1u) != 0u) x0 += size;
     if ((c & 2u) != 0u) y0 += size;
