@@ -32,8 +32,8 @@ SHARED_END
 
 SHARED_BEGIN
 
-// The guide's descents draw further numbers from their own stream: dimension | this bit
-// (the quadtree sampler's rejection stream is RNG_REJECTION_STREAM).
+// The stream id of the guide's descents (rng.h, rngStreamKey; the quadtree sampler's is
+// RNG_REJECTION_STREAM).
 #define RNG_GUIDE_STREAM 0x40000000u
 #define NUSSELT_INV_4PI 0.07957747154594767f
 
@@ -120,16 +120,16 @@ SHARED_FN float guideDirPdf(GuideView G, uint root, vec3 d) {
 
 // Draws a unit direction d (world) with density guideDirPdf from the quadtree rooted at `root`:
 // a cell by descent in proportion to the masses (mass_descent.h: uDescent, rescaled at each level;
-// its fresh numbers come from the guide's stream of rngKey = (pixel, sample, dimension, seed)),
-// then a uniform point of the cell (uCell). False when the tree has no mass.
-SHARED_FN bool guideDirSample(GuideView G, uint root, float uDescent, vec2 uCell, uvec4 rngKey, OUT(vec3) d) {
+// its fresh numbers come from the stream of uDescent and uCell, rng.h), then a uniform point of
+// the cell (uCell). A function of its numbers alone. False when the tree has no mass.
+SHARED_FN bool guideDirSample(GuideView G, uint root, float uDescent, vec2 uCell, OUT(vec3) d) {
   d = vec3(0.0f, 0.0f, 1.0f);
   uint node = root;
   float x0 = 0.0f;
   float y0 = 0.0f;
   float size = 1.0f;
   MassDescent m = massDescentStart(uDescent);
-  uvec4 stream = uvec4(rngKey.x, rngKey.y, (rngKey.z & 0xffffu) | RNG_GUIDE_STREAM, rngKey.w);
+  uvec4 stream = rngStreamKey(uDescent, uCell.x, floatBitsToUint(uCell.y), RNG_GUIDE_STREAM);
   for (uint depth = 0u; depth <= GUIDE_MAX_DIR_DEPTH; ++depth) {
     GuideDirNode N = GUIDE_DIR(G, node);
     float share;
@@ -194,7 +194,7 @@ bool guideSampleLocal(GuideVertex v, float uDescent, uint rngMode, uint pixel, u
   uint dim = rngDimension(bounce, RNG_DIM_GUIDE_CELL);
   vec2 uCell = sample2(rngMode, pixel, sampleIndex, dim, seed);
   vec3 w;
-  if (!guideDirSample(g.guide.v[0], v.root, uDescent, uCell, uvec4(pixel, sampleIndex, dim, seed), w)) return false;
+  if (!guideDirSample(g.guide.v[0], v.root, uDescent, uCell, w)) return false;
   wiLocal = toLocal(w, t, b, n);
   return wiLocal.z > 0.0f;
 }

@@ -394,13 +394,12 @@ SHARED_FN bool quadLeafSample(uint model, BrdfParams p, vec3 vk, QuadDescent d, 
 
 // Draws w for the known direction v (local frame, v.z > 0) with density quadPdf (returned in
 // pdf, per unit solid angle) and returns f = brdfEval(model, p, w, v) (rgb). u: two uniform
-// numbers (component choice and tree descent); rngKey = (pixel, sample, dimension, seed) of the
-// caller: the descent's fresh numbers and the in-leaf rejection draw from a stream of the hashed
-// key base = pcg4d(pixel, sample, RNG_REJECTION_STREAM | dimension, seed) (a double hash: see
-// below). Returns false (w = 0, pdf = 0, f = 0) when v is below the surface, the table has no
-// mass, or the rejection failed (quadLeafSample).
-SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, uvec4 rngKey, OUT(vec3) w,
-                          OUT(float) pdf, OUT(vec3) f) {
+// numbers (component choice and tree descent); the descent's fresh numbers and the in-leaf
+// rejection draw from the stream of u (rngStreamKey(u.x, u.y, 0, RNG_REJECTION_STREAM), rng.h),
+// so the sample is a function of u alone. Returns false (w = 0, pdf = 0, f = 0) when v is below
+// the surface, the table has no mass, or the rejection failed (quadLeafSample).
+SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, OUT(vec3) w, OUT(float) pdf,
+                          OUT(vec3) f) {
   w = vec3(0.0f);
   pdf = 0.0f;
   f = vec3(0.0f);
@@ -430,11 +429,12 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, uv
     vec3 vk = quadTableDirection(T);
     if (T.data.x <= 0.0f || T.info.x == QT_EMPTY) return false;
 
-    // Further numbers: from `base`, a second hash of the hashed key. One hash of a key that
-    // differs from the caller's (descent) key in one component only is strongly correlated with
-    // it (pcg4d mixes the first output little: chi-square 18000 on 2047 dof for lambert), the
-    // double hash is not. Trials use base.w + trial; the descent's fresh numbers base.z ^ const.
-    uvec4 base = pcg4d(uvec4(rngKey.x, rngKey.y, (rngKey.z & 0xffffu) | RNG_REJECTION_STREAM, rngKey.w));
+    // Further numbers: from `base`, the stream of u, hashed once more per draw. One hash of a key
+    // that differs from another key in one component only is strongly correlated with that key's
+    // hash (pcg4d mixes the first output little: chi-square 18000 on 2047 dof for lambert, when
+    // the descent number and the rejection were keyed on the same pixel key), the double hash is
+    // not. Trials use base.w + trial; the descent's fresh numbers base.z ^ const.
+    uvec4 base = rngStreamKey(u.x, u.y, 0u, RNG_REJECTION_STREAM);
     QuadDescent d;
     if (!quadDescend(T.info.x, aniso, u.x, uvec4(base.x, base.y, base.z ^ 0x5bd1e995u, base.w), d)) return false;
     float fl;

@@ -174,8 +174,7 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
     weight = brdfEval(MODEL_ID, m.M.params, wiLocal, wo) * wiLocal.z;  // f cos, over the mixture below
     pdf = 1.0f;
     q = 1.0f;
-  } else if (!bsdfSample(SAMPLER, MODEL_ID, m.M.info.z, m.M.params, wo, inside, uB,
-                         uvec4(k.pixel, k.sampleIndex, dimB, k.seed), wiLocal, weight, pdf, q))
+  } else if (!bsdfSample(SAMPLER, MODEL_ID, m.M.info.z, m.M.params, wo, inside, uB, wiLocal, weight, pdf, q))
     return false;
   if (GUIDING && m.gv.alpha > 0.0f) {
     // The mixture's density, for the weight f cos / pdf and for MIS at the next hit.
@@ -267,7 +266,6 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
 
   uint dimB = rngDimension(bounce, RNG_DIM_BSDF);
   vec2 uB = pathSample2(k, dimB);
-  uvec4 key = uvec4(k.pixel, k.sampleIndex, dimB, k.seed);
   vec3 wiLocal = vec3(0.0f, 0.0f, 1.0f);
   vec3 weight = vec3(0.0f);
   float pdf = 0.0f;
@@ -277,25 +275,25 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
   float wk = 0.0f;
   float etaK = 1.0f;  // transmissionEtaScale of the chosen component
   if (COMPONENT_COUNT > 0u && j == 0u) {
-    ok = bsdfSample(SAMPLER, MODEL_0, m.C0.info.y, m.C0.params, wo, inside, uB, key, wiLocal, weight, pdf, qk);
+    ok = bsdfSample(SAMPLER, MODEL_0, m.C0.info.y, m.C0.params, wo, inside, uB, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_0);
     wk = m.C0.data.x;
     etaK = transmissionEtaScale(MODEL_0, m.C0.params, inside);
   }
   if (COMPONENT_COUNT > 1u && j == 1u) {
-    ok = bsdfSample(SAMPLER, MODEL_1, m.C1.info.y, m.C1.params, wo, inside, uB, key, wiLocal, weight, pdf, qk);
+    ok = bsdfSample(SAMPLER, MODEL_1, m.C1.info.y, m.C1.params, wo, inside, uB, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_1);
     wk = m.C1.data.x;
     etaK = transmissionEtaScale(MODEL_1, m.C1.params, inside);
   }
   if (COMPONENT_COUNT > 2u && j == 2u) {
-    ok = bsdfSample(SAMPLER, MODEL_2, m.C2.info.y, m.C2.params, wo, inside, uB, key, wiLocal, weight, pdf, qk);
+    ok = bsdfSample(SAMPLER, MODEL_2, m.C2.info.y, m.C2.params, wo, inside, uB, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_2);
     wk = m.C2.data.x;
     etaK = transmissionEtaScale(MODEL_2, m.C2.params, inside);
   }
   if (COMPONENT_COUNT > 3u && j == 3u) {
-    ok = bsdfSample(SAMPLER, MODEL_3, m.C3.info.y, m.C3.params, wo, inside, uB, key, wiLocal, weight, pdf, qk);
+    ok = bsdfSample(SAMPLER, MODEL_3, m.C3.info.y, m.C3.params, wo, inside, uB, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_3);
     wk = m.C3.data.x;
     etaK = transmissionEtaScale(MODEL_3, m.C3.params, inside);
