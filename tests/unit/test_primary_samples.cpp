@@ -68,7 +68,8 @@ vec3 knownDirection(double thetaDeg) {
 TEST(PrimarySamples, QuadtreeSampleIsAFunctionOfItsNumbers) {
   const WardHard& w = wardHard();
   const std::uint32_t n = 20000;
-  for (double theta : {30.0, 60.5}) {  // on a table, and between tables (mixture, defensive term)
+  // On a table, and between tables (the test settings build 37 and 38 degrees: mixture, defensive term).
+  for (double theta : {30.0, 37.3}) {
     vec3 v = knownDirection(theta);
     std::vector<vec2> u(n);
     std::vector<Drawn> first(n);
