@@ -188,11 +188,9 @@ float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) {
 // uDescent = the tree descent's number; the point in the cell comes from the bounce's
 // RNG_DIM_GUIDE_CELL. False (the path ends) when the region has no mass or the direction lies
 // below the surface, where f cos = 0: the mixture's density still counts the guide's share there.
-bool guideSampleLocal(GuideVertex v, float uDescent, uint rngMode, uint pixel, uint sampleIndex, uint bounce, uint seed,
-                      vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
+bool guideSampleLocal(GuideVertex v, float uDescent, PathKey k, uint bounce, vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
   wiLocal = vec3(0.0f, 0.0f, 1.0f);
-  uint dim = rngDimension(bounce, RNG_DIM_GUIDE_CELL);
-  vec2 uCell = sample2(rngMode, pixel, sampleIndex, dim, seed);
+  vec2 uCell = pathSample2(k, rngDimension(bounce, RNG_DIM_GUIDE_CELL));
   vec3 w;
   if (!guideDirSample(g.guide.v[0], v.root, uDescent, uCell, w)) return false;
   wiLocal = toLocal(w, t, b, n);
@@ -226,8 +224,7 @@ void guideRecordSample(uint path, uint bounce, vec3 wi, float value) {
 // A module without guiding (NUSSELT_SCENE_FEATURES 0, stage_common.glsl): empty stand-ins.
 GuideVertex guideVertex(vec3 x) { return GuideVertex(0u, 0.0f); }
 float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) { return pdfBsdf; }
-bool guideSampleLocal(GuideVertex v, float uDescent, uint rngMode, uint pixel, uint sampleIndex, uint bounce, uint seed,
-                      vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
+bool guideSampleLocal(GuideVertex v, float uDescent, PathKey k, uint bounce, vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
   wiLocal = vec3(0.0f, 0.0f, 1.0f);
   return false;
 }

@@ -96,17 +96,6 @@ vec3 normalMapped(uint material, uint tri, float b1, float b2, vec3 ns, vec3 ngF
 #endif
 
 
-// ---- The path's random numbers ----
-// The key of one path sample: every draw of the walk is pathSample2(key, dimension) (rng.h).
-struct PathKey {
-  uint rngMode;
-  uint pixel;
-  uint sampleIndex;
-  uint seed;
-};
-vec2 pathSample2(PathKey k, uint dimension) { return sample2(k.rngMode, k.pixel, k.sampleIndex, dimension, k.seed); }
-float pathSample1(PathKey k, uint dimension) { return sample1(k.rngMode, k.pixel, k.sampleIndex, dimension, k.seed); }
-
 // One step of the walk as the material's sampler drew it: the local direction, the factor the
 // throughput is multiplied by (weight, divided by the choice and albedo-roulette probabilities),
 // the density for MIS at the next hit and for the guide's record, the eta scale of a transmission,
@@ -170,7 +159,7 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
   if (GUIDING && m.gv.alpha > 0.0f) uG = pathSample2(k, rngDimension(bounce, RNG_DIM_GUIDE));
   bool guided = GUIDING && uG.x < m.gv.alpha;
   if (guided) {
-    if (!guideSampleLocal(m.gv, uG.y, k.rngMode, k.pixel, k.sampleIndex, bounce, k.seed, tt, bb, ns, wiLocal)) return false;
+    if (!guideSampleLocal(m.gv, uG.y, k, bounce, tt, bb, ns, wiLocal)) return false;
     weight = brdfEval(MODEL_ID, m.M.params, wiLocal, wo) * wiLocal.z;  // f cos, over the mixture below
     pdf = 1.0f;
     q = 1.0f;
@@ -368,8 +357,7 @@ void main() {
   if (idx >= queueCount(queue)) return;
   uint path = queueItem(queue, idx);
   uint bounce = pc.bounce;
-  uvec4 info = g.pathInfo.v[path];
-  PathKey key = PathKey(g.rngMode, info.x, info.y, g.seed);
+  PathKey key = pathKey(path);  // every draw: pathSample1/2(key, dimension) (stage_common.glsl)
   uint lighting = g.lighting;
   uint roulette = g.roulette;
 
