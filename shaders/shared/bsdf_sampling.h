@@ -91,16 +91,16 @@ SHARED_FN float bsdfPdf(uint strategy, uint model, uint quadSet, BrdfParams p, v
 // Draws wi for the known direction wo (wo.z > 0; a model that is not delta) with strategy s (a
 // SAMPLER_* id, after effectiveSampler) and two uniform numbers u in [0, 1), and returns the
 // density pdf and f = f(wi, wo) (the quadtree returns the value its rejection test evaluated).
-// rngKey = (pixel or sample, sample index, dimension, seed) keys the quadtree's rejection stream.
-// False for a failed sample. The one strategy switch: the shade stage (through bsdfSample), the
+// A function of u alone (the quadtree's further numbers come from the stream of u: rng.h,
+// rngStreamKey). False for a failed sample. The one strategy switch: the shade stage (through bsdfSample), the
 // sample tool (shaders/tools/sample_tool.comp) and `nusselt sample --cpu` all draw through it.
-SHARED_FN bool strategySample(uint s, uint model, uint set, BrdfParams p, vec3 wo, vec2 u, uvec4 rngKey, OUT(vec3) wi,
-                              OUT(float) pdf, OUT(vec3) f) {
+SHARED_FN bool strategySample(uint s, uint model, uint set, BrdfParams p, vec3 wo, vec2 u, OUT(vec3) wi, OUT(float) pdf,
+                              OUT(vec3) f) {
   wi = vec3(0.0f, 0.0f, 1.0f);
   pdf = 0.0f;
   f = vec3(0.0f);
 #if NUSSELT_WITH_QUADTREE
-  if (s == SAMPLER_QUADTREE) return quadSample(set, model, p, wo, u, rngKey, wi, pdf, f) && pdf > 0.0f;
+  if (s == SAMPLER_QUADTREE) return quadSample(set, model, p, wo, u, wi, pdf, f) && pdf > 0.0f;
 #endif
   if (false) {
 #if NUSSELT_WITH_ANALYTIC
@@ -130,10 +130,9 @@ SHARED_FN bool strategySample(uint s, uint model, uint set, BrdfParams p, vec3 w
 
 // inside: the path arrived from the inside (the back side of the surface's front face), which
 // matters for refraction only: the dielectric's relative index is then 1/eta.
-// rngKey = (pixel, sample index, dimension, seed) of the draw: the quadtree's rejection loop
-// takes its further numbers from its own stream of that key.
+// The sample is a function of u alone (Metropolis, issue 19).
 SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p, vec3 wo, bool inside, vec2 u,
-                          uvec4 rngKey, OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(float) continuation) {
+                          OUT(vec3) wi, OUT(vec3) weight, OUT(float) pdf, OUT(float) continuation) {
   wi = vec3(0.0f, 0.0f, 1.0f);
   weight = vec3(0.0f);
   pdf = 0.0f;
@@ -142,7 +141,7 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
   if (modelIsDelta(model)) return deltaSample(model, p, wo, inside, u, wi, weight, continuation);
   uint s = effectiveSampler(strategy, quadSet);
   vec3 f;
-  if (!strategySample(s, model, quadSet, p, wo, u, rngKey, wi, pdf, f)) return false;
+  if (!strategySample(s, model, quadSet, p, wo, u, wi, pdf, f)) return false;
   weight = f * (wi.z / pdf);
 #if NUSSELT_WITH_QUADTREE
   // The random-walk source's roulette: continue with the tabulated directional albedo. With

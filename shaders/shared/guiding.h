@@ -9,6 +9,7 @@
 #define NUSSELT_GUIDING_H
 #include "guiding_layout.h"
 #include "rng.h"
+#include "mass_descent.h"
 
 #ifdef __cplusplus
 SHARED_BEGIN
@@ -31,8 +32,8 @@ SHARED_END
 
 SHARED_BEGIN
 
-// The guide's descents draw further numbers from their own stream: dimension | this bit
-// (the quadtree sampler's rejection stream is RNG_REJECTION_STREAM).
+// The stream id of the guide's descents (rng.h, rngStreamKey; the quadtree sampler's is
+// RNG_REJECTION_STREAM).
 #define RNG_GUIDE_STREAM 0x40000000u
 #define NUSSELT_INV_4PI 0.07957747154594767f
 
@@ -117,60 +118,23 @@ SHARED_FN float guideDirPdf(GuideView G, uint root, vec3 d) {
   return guideSquarePdf(G, root, guideDirectionToSquare(d)) * NUSSELT_INV_4PI;
 }
 
-// Child of a node by its masses with the uniform number u in [0, 1), which is rescaled to the
-// chosen child's share (one number serves several levels). A child whose interval is empty in
-// floats is never chosen; when rounding puts u x total at or past the total, the heaviest child
-// is taken. share = the chosen child's mass / the node's (0: the node has no mass).
-SHARED_FN uint guidePickChild(vec4 m, INOUT(float) u, OUT(float) share) {
-  float total = m.x + m.y + m.z + m.w;
-  share = 0.0f;
-  if (!(total > 0.0f)) return 0u;
-  float t = u * total;
-  float e1 = m.x;
-  float e2 = m.x + m.y;
-  float e3 = m.x + m.y + m.z;
-  uint c;
-  float below;
-  if (t < e1) { c = 0u; below = 0.0f; }
-  else if (t < e2) { c = 1u; below = e1; }
-  else if (t < e3) { c = 2u; below = e2; }
-  else if (t < total) { c = 3u; below = e3; }
-  else {
-    c = 0u;
-    if (m.y > m[c]) c = 1u;
-    if (m.z > m[c]) c = 2u;
-    if (m.w > m[c]) c = 3u;
-    below = t - m[c];
-  }
-  u = clamp((t - below) / m[c], 0.0f, NUSSELT_ONE_MINUS_EPS);
-  share = m[c] / total;
-  return c;
-}
-
 // Draws a unit direction d (world) with density guideDirPdf from the quadtree rooted at `root`:
-// a cell by descent in proportion to the masses (uDescent, rescaled at each level; once the
-// path's probability falls below 2^-10 a fresh number from the guide's stream of rngKey = (pixel,
-// sample, dimension, seed) takes over, so that a cell far below 2^-24 of the total keeps its
-// odds), then a uniform point of the cell (uCell). False when the tree has no mass.
-SHARED_FN bool guideDirSample(GuideView G, uint root, float uDescent, vec2 uCell, uvec4 rngKey, OUT(vec3) d) {
+// a cell by descent in proportion to the masses (mass_descent.h: uDescent, rescaled at each level;
+// its fresh numbers come from the stream of uDescent and uCell, rng.h), then a uniform point of
+// the cell (uCell). A function of its numbers alone. False when the tree has no mass.
+SHARED_FN bool guideDirSample(GuideView G, uint root, float uDescent, vec2 uCell, OUT(vec3) d) {
   d = vec3(0.0f, 0.0f, 1.0f);
   uint node = root;
   float x0 = 0.0f;
   float y0 = 0.0f;
   float size = 1.0f;
-  float u = uDescent;
-  float pathShare = 1.0f;
+  MassDescent m = massDescentStart(uDescent);
+  uvec4 stream = rngStreamKey(uDescent, uCell.x, floatBitsToUint(uCell.y), RNG_GUIDE_STREAM);
   for (uint depth = 0u; depth <= GUIDE_MAX_DIR_DEPTH; ++depth) {
     GuideDirNode N = GUIDE_DIR(G, node);
-    if (pathShare < 1.0f / 1024.0f) {
-      uvec4 h = pcg4d(uvec4(rngKey.x, rngKey.y, (rngKey.z & 0xffffu) | RNG_GUIDE_STREAM, rngKey.w + depth));
-      u = float(h.x >> 8u) * (1.0f / 16777216.0f);
-      pathShare = 1.0f;
-    }
     float share;
-    uint c = guidePickChild(N.mass, u, share);
+    uint c = massDescendStep(N.mass, stream, m, share);
     if (!(share > 0.0f)) return false;
-    pathShare *= share;
     size *= 0.5f;
     if ((c & 1u) != 0u) x0 += size;
     if ((c & 2u) != 0u) y0 += size;
@@ -224,13 +188,11 @@ float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) {
 // uDescent = the tree descent's number; the point in the cell comes from the bounce's
 // RNG_DIM_GUIDE_CELL. False (the path ends) when the region has no mass or the direction lies
 // below the surface, where f cos = 0: the mixture's density still counts the guide's share there.
-bool guideSampleLocal(GuideVertex v, float uDescent, uint rngMode, uint pixel, uint sampleIndex, uint bounce, uint seed,
-                      vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
+bool guideSampleLocal(GuideVertex v, float uDescent, PathKey k, uint bounce, vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
   wiLocal = vec3(0.0f, 0.0f, 1.0f);
-  uint dim = rngDimension(bounce, RNG_DIM_GUIDE_CELL);
-  vec2 uCell = sample2(rngMode, pixel, sampleIndex, dim, seed);
+  vec2 uCell = pathSample2(k, rngDimension(bounce, RNG_DIM_GUIDE_CELL));
   vec3 w;
-  if (!guideDirSample(g.guide.v[0], v.root, uDescent, uCell, uvec4(pixel, sampleIndex, dim, seed), w)) return false;
+  if (!guideDirSample(g.guide.v[0], v.root, uDescent, uCell, w)) return false;
   wiLocal = toLocal(w, t, b, n);
   return wiLocal.z > 0.0f;
 }
@@ -262,8 +224,7 @@ void guideRecordSample(uint path, uint bounce, vec3 wi, float value) {
 // A module without guiding (NUSSELT_SCENE_FEATURES 0, stage_common.glsl): empty stand-ins.
 GuideVertex guideVertex(vec3 x) { return GuideVertex(0u, 0.0f); }
 float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) { return pdfBsdf; }
-bool guideSampleLocal(GuideVertex v, float uDescent, uint rngMode, uint pixel, uint sampleIndex, uint bounce, uint seed,
-                      vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
+bool guideSampleLocal(GuideVertex v, float uDescent, PathKey k, uint bounce, vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
   wiLocal = vec3(0.0f, 0.0f, 1.0f);
   return false;
 }

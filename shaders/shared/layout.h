@@ -204,6 +204,7 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer Materials {
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Components { GpuComponent v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Lights { GpuLight v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Vec4s { vec4 v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) buffer Vec2s { vec2 v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer UVec4s { uvec4 v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer Floats { float v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer Uints { uint v[]; };
@@ -262,7 +263,7 @@ struct Globals {
   uint environmentLight; // the environment's index in the light list, or INVALID_INDEX: no environment
   uint texturedScene;    // 1: some material has a texture that applies (the HAS_TEXTURES stages), else 0
   uint alphaScene;       // 1: some material has alphaMode MASK or BLEND (the HAS_ALPHA tracing stages), else 0
-  uint reserved3;
+  uint primaryDims;      // primary samples per path in primarySamples (PRIMARY_SAMPLES, stage_common.glsl), 0: none
   vec4 camPosition; // xyz, w = 1 for orthographic
   vec4 camRight;    // unit right * (tan(yfov/2) * aspect), or * xmag for orthographic
   vec4 camUp;       // unit up * tan(yfov/2), or * ymag for orthographic
@@ -310,12 +311,13 @@ struct Globals {
   BUFREF(Vec4s) tangents;      // per triangle 3 vec4, the corners' tangents (Scene::tangents: xyz, w = bitangent
                                // sign), parallel to `triangles`; one entry when no material is normal-mapped
   BUFREF(GpuGuides) guide;     // one GpuGuide (guiding_layout.h; 0 unless the render is guided)
+  BUFREF(Vec2s) primarySamples; // per path primaryDims 2-D draws (PRIMARY_SAMPLES stages only; 0 otherwise)
   // The top-level acceleration structure's device address, low and high 32 bits, for ray queries
   // (shaders/shared/trace.glsl with NUSSELT_RAY_QUERY); 0 when the GLSL BVH traces.
   uint tlasLow;
   uint tlasHigh;
 };
-STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 37 * 8 + 8);
+STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 38 * 8 + 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 

@@ -19,7 +19,7 @@ SHARED_BEGIN
 #define RNG_DIM_COMPONENT 6u
 #define RNG_DIM_GUIDE 7u         // and 8: path guiding's choice of the guide, its tree descent
 #define RNG_DIM_GUIDE_CELL 9u    // and 10: the point in the guide's chosen cell
-// Rejection loops (the quadtree sampler) draw from their own stream: dimension | this bit.
+// The quadtree sampler's stream of further numbers (rngStreamKey).
 #define RNG_REJECTION_STREAM 0x80000000u
 
 SHARED_FN uint rngDimension(uint bounce, uint slot) { return 2u + bounce * RNG_DIMS_PER_BOUNCE + slot; }
@@ -47,6 +47,21 @@ SHARED_FN vec2 rng2(uint pixel, uint sampleIndex, uint dimension, uint seed) {
 
 SHARED_FN float rng1(uint pixel, uint sampleIndex, uint dimension, uint seed) {
   return rng2(pixel, sampleIndex, dimension, seed).x;
+}
+
+// ---- Streams of further numbers -----------------------------------------------------------------
+// A sampler that consumes a variable count of numbers (the quadtree's rejection trials, the fresh
+// numbers of a tree descent that ran out of resolution) draws them from a stream keyed on the
+// primary numbers it received (a, b, c: their bits) and a stream id, never on the pixel, sample
+// index or seed: a path is then a function of its primary numbers alone, as primary-sample-space
+// Metropolis needs (issue 19), whatever sampler (hash, QMC, a Markov chain) produced them. The
+// numbers should carry more bits than the sampler consumes deterministically (the quadtree keys on
+// both of its numbers, the guide on its descent number and its cell point), so the stream adds
+// resolution where the primary numbers run out of it. Draw i of the stream is pcg4d(key + (0, 0,
+// 0, i)), a second hash of the key: one hash of keys that differ in one component only is
+// correlated with the first (quadtree.h).
+SHARED_FN uvec4 rngStreamKey(float a, float b, uint c, uint stream) {
+  return pcg4d(uvec4(floatBitsToUint(a), floatBitsToUint(b), c, stream));
 }
 
 // ---- Quasi-Monte Carlo: padded, Owen-scrambled Sobol (0,2)-sequences ----------------------------

@@ -29,6 +29,45 @@
 #include "shared/warp.h"
 #include "shared/texture.h"
 
+// ---- The path's random numbers: the primary sample source (issue 19) ----------------------------
+// Every draw of a path goes through pathSample2 / pathSample1 (key, dimension), the dimensions of
+// rng.h. The default source hashes (pixel, sample index, dimension, seed) (or QMC: sample2). A
+// stage specialised with PRIMARY_SAMPLES (constant 11; no integrator sets it yet) reads the first
+// g.primaryDims dimensions of a path from its slot of g.primarySamples instead: the primary sample
+// vector that a primary-sample-space Metropolis chain mutates (dimensions beyond them still hash).
+// The samplers' further numbers follow their primary numbers (rng.h, rngStreamKey), so a path is
+// a function of this vector. Off, the branch is compiled out and the images are those of the hash.
+#if NUSSELT_SCENE_FEATURES
+layout(constant_id = 11) const bool PRIMARY_SAMPLES = false;
+#else
+const bool PRIMARY_SAMPLES = false;
+#endif
+
+// The key of one path sample: its pixel and sample index, the render's mode and seed, and the
+// path's slot (the index of its state and of its primary samples).
+struct PathKey {
+  uint rngMode;
+  uint pixel;
+  uint sampleIndex;
+  uint seed;
+  uint path;
+};
+
+PathKey pathKey(uint path) {
+  uvec4 info = g.pathInfo.v[path];
+  return PathKey(g.rngMode, info.x, info.y, g.seed, path);
+}
+
+vec2 pathSample2(PathKey k, uint dimension) {
+  if (PRIMARY_SAMPLES && dimension < g.primaryDims) {
+    Vec2s p = g.primarySamples;
+    return p.v[k.path * g.primaryDims + dimension];
+  }
+  return sample2(k.rngMode, k.pixel, k.sampleIndex, dimension, k.seed);
+}
+
+float pathSample1(PathKey k, uint dimension) { return pathSample2(k, dimension).x; }
+
 // ---- Alpha coverage (glTF alphaMode; docs/scenes.md, "Alpha") ---------------------------------
 // The tracing stages of a scene with MASK or BLEND materials test every candidate hit (constant
 // 9, set by the integrator for intersect and shadow only; false elsewhere, the tools included).

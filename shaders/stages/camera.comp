@@ -16,7 +16,7 @@ void main() {
   uint py = pixel / width;
 
   // Pixel jitter: dimensions 0 and 1 (box filter over the pixel).
-  vec2 u = sample2(g.rngMode, pixel, sampleIndex, 0u, g.seed);
+  vec2 u = pathSample2(PathKey(g.rngMode, pixel, sampleIndex, g.seed, i), 0u);
   float sx = ((float(px) + u.x) / float(width)) * 2.0f - 1.0f;
   float sy = 1.0f - ((float(py) + u.y) / float(g.height)) * 2.0f;
 

@@ -123,18 +123,270 @@ void evalParams(uint model, uint material, uint tri, float b1, float b2, inout B
 vec3 normalMapped(uint material, uint tri, float b1, float b2, vec3 ns, vec3 ngFront) { return ns; }
 #endif
 
+
+// One step of the walk as the material's sampler drew it: the local direction, the factor the
+// throughput is multiplied by (weight, divided by the choice and albedo-roulette probabilities),
+// the density for MIS at the next hit and for the guide's record, the eta scale of a transmission,
+// and whether the sample was a delta lobe's.
+struct PathStep {
+  vec3 wiLocal;
+  vec3 factor;
+  float pdf;
+  float etaScale;
+  bool delta;
+};
+
+// ---- The material at a hit: one interface, two implementations ----
+// ShadeMaterial      what the material needs at this hit (set up once by shadeMaterial)
+// shadeLightSamples  whether next-event estimation applies (not for delta materials)
+// shadeEval          f(wi, wo) (rgb) for a light sample
+// shadeMisPdf        the density with which shadeSample would draw wi (MIS against light sampling)
+// shadeSample        the next direction, its factor and density (PathStep); false ends the walk
+// nextEvent and continuePath below are written once over them.
+#if !SHADE_COMBINED
+// ---- A single-model material (MODEL_ID); guided where the guide has learned (guiding.h) ----
+struct ShadeMaterial {
+  GpuMaterial M;
+  GuideVertex gv;  // the guide's region (path guiding): never for delta models
+};
+
+ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette) {
+  ShadeMaterial m;
+  m.M = M;
+  m.gv = GuideVertex(0u, 0.0f);
+  if (GUIDING && !modelIsDelta(MODEL_ID)) m.gv = guideVertex(x);
+  return m;
+}
+
+bool shadeLightSamples(ShadeMaterial m) { return !modelIsDelta(MODEL_ID); }
+
+vec3 shadeEval(ShadeMaterial m, vec3 wi, vec3 wo) { return brdfEval(MODEL_ID, m.M.params, wi, wo); }
+
+float shadeMisPdf(ShadeMaterial m, vec3 wo, vec3 wi, vec3 wiWorld) {
+  float pdfB = bsdfPdf(SAMPLER, MODEL_ID, m.M.info.z, m.M.params, wo, wi);
+  if (GUIDING) pdfB = guideMixture(m.gv, wiWorld, pdfB);
+  return pdfB;
+}
+
+// BSDF sampling, or the guide with probability alpha (one-sample MIS); uR: the roulette's number
+// (the albedo roulette decides here, with the sample's continuation probability q).
+bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo, bool inside, vec3 tt, vec3 bb,
+                 vec3 ns, float uR, out PathStep s) {
+  s.wiLocal = vec3(0.0f, 0.0f, 1.0f);
+  s.factor = vec3(0.0f);
+  s.pdf = 0.0f;
+  s.etaScale = 1.0f;
+  s.delta = modelIsDelta(MODEL_ID);
+  uint dimB = rngDimension(bounce, RNG_DIM_BSDF);
+  vec2 uB = pathSample2(k, dimB);
+  vec3 wiLocal;
+  vec3 weight;
+  float pdf;
+  float q;
+  vec2 uG = vec2(1.0f);
+  if (GUIDING && m.gv.alpha > 0.0f) uG = pathSample2(k, rngDimension(bounce, RNG_DIM_GUIDE));
+  bool guided = GUIDING && uG.x < m.gv.alpha;
+  if (guided) {
+    if (!guideSampleLocal(m.gv, uG.y, k, bounce, tt, bb, ns, wiLocal)) return false;
+    weight = brdfEval(MODEL_ID, m.M.params, wiLocal, wo) * wiLocal.z;  // f cos, over the mixture below
+    pdf = 1.0f;
+    q = 1.0f;
+  } else if (!bsdfSample(SAMPLER, MODEL_ID, m.M.info.z, m.M.params, wo, inside, uB, wiLocal, weight, pdf, q))
+    return false;
+  if (GUIDING && m.gv.alpha > 0.0f) {
+    // The mixture's density, for the weight f cos / pdf and for MIS at the next hit.
+    float pdfB = guided ? bsdfPdf(SAMPLER, MODEL_ID, m.M.info.z, m.M.params, wo, wiLocal) : pdf;
+    float pdfMix = guideMixture(m.gv, toWorld(wiLocal, tt, bb, ns), pdfB);
+    if (!(pdfMix > 0.0f)) return false;
+    weight *= pdf / pdfMix;
+    if (guided) q = min(1.0f, luminance(weight));
+    pdf = pdfMix;
+  }
+  // The albedo roulette: with the continuation probability of the sample (the source's).
+  if (roulette == ROULETTE_ALBEDO) {
+    if (!(q > 0.0f) || uR >= q) return false;
+    s.factor = weight / q;
+  } else {
+    s.factor = weight;
+  }
+  s.wiLocal = wiLocal;
+  s.pdf = pdf;
+  s.etaScale = transmissionEtaScale(MODEL_ID, m.M.params, inside);
+  return true;
+}
+
+#else
+// ---- A combined material: sum_k w_k f_k (shaders/shared/combined.h, docs/models.md) ----
+struct ShadeMaterial {
+  GpuComponent C0, C1, C2, C3;
+  vec4 a;            // choice weights a_k = w_k A_k(wo), from wo only
+  vec4 c;            // MIS probabilities (0 for delta components, which have no MIS density)
+  uint mode;         // the choice mode (combinedChoiceMode)
+  bool lightSamples; // no delta flag on the material
+};
+
+ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette) {
+  ShadeMaterial m;
+  m.a = vec4(0.0f);
+  uint first = M.components.x;
+  m.mode = combinedChoiceMode(g.componentChoice, roulette);
+  if (COMPONENT_COUNT > 0u) { m.C0 = g.components.v[first]; m.a.x = componentChoiceWeight(m.mode, SAMPLER, MODEL_0, m.C0, wo); }
+  if (COMPONENT_COUNT > 1u) { m.C1 = g.components.v[first + 1u]; m.a.y = componentChoiceWeight(m.mode, SAMPLER, MODEL_1, m.C1, wo); }
+  if (COMPONENT_COUNT > 2u) { m.C2 = g.components.v[first + 2u]; m.a.z = componentChoiceWeight(m.mode, SAMPLER, MODEL_2, m.C2, wo); }
+  if (COMPONENT_COUNT > 3u) { m.C3 = g.components.v[first + 3u]; m.a.w = componentChoiceWeight(m.mode, SAMPLER, MODEL_3, m.C3, wo); }
+  vec4 P = combinedChoiceProbabilities(m.mode, COMPONENT_COUNT, m.a);
+  m.c = combinedMisProbabilities(P);
+  // Delta components take no light samples and have no MIS density: their c is dropped.
+  if (modelIsDelta(MODEL_0)) m.c.x = 0.0f;
+  if (modelIsDelta(MODEL_1)) m.c.y = 0.0f;
+  if (modelIsDelta(MODEL_2)) m.c.z = 0.0f;
+  if (modelIsDelta(MODEL_3)) m.c.w = 0.0f;
+  m.lightSamples = (M.info.y & MATERIAL_DELTA) == 0u;
+  return m;
+}
+
+bool shadeLightSamples(ShadeMaterial m) { return m.lightSamples; }
+
+// The sum of the non-delta components.
+vec3 shadeEval(ShadeMaterial m, vec3 wi, vec3 wo) {
+  vec3 f = vec3(0.0f);
+  if (COMPONENT_COUNT > 0u) f += componentEval(MODEL_0, m.C0, wi, wo);
+  if (COMPONENT_COUNT > 1u) f += componentEval(MODEL_1, m.C1, wi, wo);
+  if (COMPONENT_COUNT > 2u) f += componentEval(MODEL_2, m.C2, wi, wo);
+  if (COMPONENT_COUNT > 3u) f += componentEval(MODEL_3, m.C3, wi, wo);
+  return f;
+}
+
+float shadeMisPdf(ShadeMaterial m, vec3 wo, vec3 wi, vec3 wiWorld) {
+  float pdf = 0.0f;
+  if (COMPONENT_COUNT > 0u) pdf += componentMisPdf(MODEL_0, m.C0, m.c.x, wo, wi);
+  if (COMPONENT_COUNT > 1u) pdf += componentMisPdf(MODEL_1, m.C1, m.c.y, wo, wi);
+  if (COMPONENT_COUNT > 2u) pdf += componentMisPdf(MODEL_2, m.C2, m.c.z, wo, wi);
+  if (COMPONENT_COUNT > 3u) pdf += componentMisPdf(MODEL_3, m.C3, m.c.w, wo, wi);
+  return pdf;
+}
+
+// The component choice (albedo mode under the albedo roulette: includes the roulette), then the
+// chosen component's sample; factor w_k f_k cos / (P_k pdf_k), with uniform mode's separate albedo
+// roulette (uR) under the albedo roulette. Combined materials are not guided yet.
+bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo, bool inside, vec3 tt, vec3 bb,
+                 vec3 ns, float uR, out PathStep s) {
+  s.wiLocal = vec3(0.0f, 0.0f, 1.0f);
+  s.factor = vec3(0.0f);
+  s.pdf = 0.0f;
+  s.etaScale = 1.0f;
+  s.delta = false;
+  float uC = pathSample1(k, rngDimension(bounce, RNG_DIM_COMPONENT));
+  uint j;
+  float pk;
+  if (!combinedPick(m.mode, COMPONENT_COUNT, m.a, uC, j, pk) || !(pk > 0.0f)) return false;
+
+  uint dimB = rngDimension(bounce, RNG_DIM_BSDF);
+  vec2 uB = pathSample2(k, dimB);
+  vec3 wiLocal = vec3(0.0f, 0.0f, 1.0f);
+  vec3 weight = vec3(0.0f);
+  float pdf = 0.0f;
+  float qk;  // the component's own continuation: not used (the choice above is the roulette)
+  bool ok = false;
+  bool delta = false;
+  float wk = 0.0f;
+  float etaK = 1.0f;  // transmissionEtaScale of the chosen component
+  if (COMPONENT_COUNT > 0u && j == 0u) {
+    ok = bsdfSample(SAMPLER, MODEL_0, m.C0.info.y, m.C0.params, wo, inside, uB, wiLocal, weight, pdf, qk);
+    delta = modelIsDelta(MODEL_0);
+    wk = m.C0.data.x;
+    etaK = transmissionEtaScale(MODEL_0, m.C0.params, inside);
+  }
+  if (COMPONENT_COUNT > 1u && j == 1u) {
+    ok = bsdfSample(SAMPLER, MODEL_1, m.C1.info.y, m.C1.params, wo, inside, uB, wiLocal, weight, pdf, qk);
+    delta = modelIsDelta(MODEL_1);
+    wk = m.C1.data.x;
+    etaK = transmissionEtaScale(MODEL_1, m.C1.params, inside);
+  }
+  if (COMPONENT_COUNT > 2u && j == 2u) {
+    ok = bsdfSample(SAMPLER, MODEL_2, m.C2.info.y, m.C2.params, wo, inside, uB, wiLocal, weight, pdf, qk);
+    delta = modelIsDelta(MODEL_2);
+    wk = m.C2.data.x;
+    etaK = transmissionEtaScale(MODEL_2, m.C2.params, inside);
+  }
+  if (COMPONENT_COUNT > 3u && j == 3u) {
+    ok = bsdfSample(SAMPLER, MODEL_3, m.C3.info.y, m.C3.params, wo, inside, uB, wiLocal, weight, pdf, qk);
+    delta = modelIsDelta(MODEL_3);
+    wk = m.C3.data.x;
+    etaK = transmissionEtaScale(MODEL_3, m.C3.params, inside);
+  }
+  if (!ok || !(wk > 0.0f)) return false;
+
+  float p = pk;
+  if (roulette == ROULETTE_ALBEDO && m.mode == COMPONENTS_UNIFORM) {
+    float q = combinedUniformContinuation(m.a);
+    if (!(q > 0.0f) || uR >= q) return false;
+    p *= q;
+  }
+  s.wiLocal = wiLocal;
+  s.factor = weight * (wk / p);
+  // MIS density of the sampled direction: sum over the non-delta components (0 after a delta lobe).
+  s.pdf = delta ? 0.0f : shadeMisPdf(m, wo, wiLocal, vec3(0.0f));
+  s.etaScale = etaK;
+  s.delta = delta;
+  return true;
+}
+#endif
+
+// ---- Next-event estimation: a light sample, its shadow ray queued with the MIS-weighted value ----
+void nextEvent(ShadeMaterial m, uint path, PathKey k, uint bounce, uint lighting, vec3 xo, vec3 ng, vec3 tt, vec3 bb,
+               vec3 ns, vec3 wo, vec3 beta) {
+  float uSel = pathSample1(k, rngDimension(bounce, RNG_DIM_LIGHT_SELECT));
+  vec2 uPt = pathSample2(k, rngDimension(bounce, RNG_DIM_LIGHT_POINT));
+  LightSample ls;
+  if (sampleLight(xo, uSel, uPt, ls) && dot(ls.wi, ng) > 0.0f) {
+    vec3 wiL = toLocal(ls.wi, tt, bb, ns);
+    vec3 f = shadeEval(m, wiL, wo);
+    float cosS = max(wiL.z, 0.0f);
+    vec3 c = beta * f * cosS * ls.value;
+    if (ls.pdf > 0.0f && lighting == LIGHTING_MIS) c *= powerHeuristic(ls.pdf, shadeMisPdf(m, wo, wiL, ls.wi));
+    if (max(c.x, max(c.y, c.z)) > 0.0f) {
+      // Stop short of the light so that the emitter itself never occludes.
+      float tmax = ls.dist < 1.0e38f ? ls.dist * (1.0f - 1e-4f) : ls.dist;
+      g.shadowOrigin.v[path] = vec4(xo, tmax);
+      g.shadowDirection.v[path] = vec4(ls.wi, 0.0f);
+      g.shadowRadiance.v[path] = vec4(c, 0.0f);
+      queuePush(QUEUE_SHADOW, path);
+    }
+  }
+}
+
+// ---- Path continuation: the sampled step becomes the next ray, or the walk ends ----
+// Reflection must stay above the geometric surface (else light leaks through it); refraction
+// (only delta models transmit) must cross it, and leaves from the other side. Then the throughput
+// roulette (the default; the albedo roulette decided in shadeSample): survivors are divided by
+// the probability.
+void continuePath(PathStep s, uint path, uint bounce, uint roulette, vec3 x, vec3 xo, vec3 ng, vec3 tt, vec3 bb,
+                  vec3 ns, vec3 beta, float etaScale, float uR) {
+  vec3 wi = toWorld(s.wiLocal, tt, bb, ns);
+  bool transmitted = s.wiLocal.z < 0.0f;
+  if (transmitted != (dot(wi, ng) < 0.0f)) return;
+  if (transmitted) xo = offsetRay(x, -ng);
+  beta *= s.factor;
+  if (roulette != ROULETTE_ALBEDO) {
+    if (transmitted) etaScale *= s.etaScale;
+    if (!throughputRoulette(bounce, beta, etaScale, uR)) return;
+  }
+  if (GUIDING) guideRecordSample(path, bounce, wi, s.delta ? -1.0f : luminance(beta) * s.pdf);
+  g.pathOrigin.v[path] = vec4(xo, 0.0f);
+  g.pathDirection.v[path] = vec4(wi, s.pdf);
+  g.pathThroughput.v[path] = vec4(beta, etaScale);
+  queuePush(((bounce + 1u) & 1u), path);
+}
+
 void main() {
   uint idx = gl_GlobalInvocationID.x;
   uint queue = QUEUE_SHADE_BASE + pc.modelSlot;
   if (idx >= queueCount(queue)) return;
   uint path = queueItem(queue, idx);
   uint bounce = pc.bounce;
-  uvec4 info = g.pathInfo.v[path];
-  uint pixel = info.x;
-  uint sampleIndex = info.y;
-  uint seed = g.seed;
+  PathKey key = pathKey(path);  // every draw: pathSample1/2(key, dimension) (stage_common.glsl)
   uint lighting = g.lighting;
-  uint rngMode = g.rngMode;
   uint roulette = g.roulette;
 
   // ---- Hit geometry ----
@@ -195,220 +447,16 @@ void main() {
   vec3 xo = offsetRay(x, ng);
   bool last = bounce >= g.maxDepth;
 
-#if !SHADE_COMBINED
-  {
-    // ---- A single-model material ----
-    // The guide's region (path guiding, guiding.h): never for delta models.
-    GuideVertex gv = GuideVertex(0u, 0.0f);
-    if (GUIDING && !modelIsDelta(MODEL_ID)) gv = guideVertex(x);
-    // ---- Next-event estimation ----
-    if (!last && lighting != LIGHTING_BSDF_ONLY && !modelIsDelta(MODEL_ID)) {
-      float uSel = sample1(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_LIGHT_SELECT), seed);
-      vec2 uPt = sample2(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_LIGHT_POINT), seed);
-      LightSample ls;
-      if (sampleLight(xo, uSel, uPt, ls) && dot(ls.wi, ng) > 0.0f) {
-        vec3 wiL = toLocal(ls.wi, tt, bb, ns);
-        vec3 f = brdfEval(MODEL_ID, M.params, wiL, wo);
-        float cosS = max(wiL.z, 0.0f);
-        vec3 c = beta * f * cosS * ls.value;
-        if (ls.pdf > 0.0f && lighting == LIGHTING_MIS) {
-          float pdfB = bsdfPdf(SAMPLER, MODEL_ID, M.info.z, M.params, wo, wiL);
-          if (GUIDING) pdfB = guideMixture(gv, ls.wi, pdfB);
-          c *= powerHeuristic(ls.pdf, pdfB);
-        }
-        if (max(c.x, max(c.y, c.z)) > 0.0f) {
-          // Stop short of the light so that the emitter itself never occludes.
-          float tmax = ls.dist < 1.0e38f ? ls.dist * (1.0f - 1e-4f) : ls.dist;
-          g.shadowOrigin.v[path] = vec4(xo, tmax);
-          g.shadowDirection.v[path] = vec4(ls.wi, 0.0f);
-          g.shadowRadiance.v[path] = vec4(c, 0.0f);
-          queuePush(QUEUE_SHADOW, path);
-        }
-      }
-    }
-
-    g.pathRadiance.v[path].xyz += L;
-    if (last) return;
-
-    // ---- BSDF sampling: the next step of the random walk ----
-    uint dimB = rngDimension(bounce, RNG_DIM_BSDF);
-    vec2 uB = sample2(rngMode, pixel, sampleIndex, dimB, seed);
-    vec3 wiLocal;
-    vec3 weight;
-    float pdf;
-    float q;
-    // Path guiding: the guide with probability alpha, the BSDF sampler otherwise (one-sample MIS).
-    vec2 uG = vec2(1.0f);
-    if (GUIDING && gv.alpha > 0.0f) uG = sample2(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_GUIDE), seed);
-    bool guided = GUIDING && uG.x < gv.alpha;
-    if (guided) {
-      if (!guideSampleLocal(gv, uG.y, rngMode, pixel, sampleIndex, bounce, seed, tt, bb, ns, wiLocal)) return;
-      weight = brdfEval(MODEL_ID, M.params, wiLocal, wo) * wiLocal.z;  // f cos, over the mixture below
-      pdf = 1.0f;
-      q = 1.0f;
-    } else if (!bsdfSample(SAMPLER, MODEL_ID, M.info.z, M.params, wo, !frontFace, uB, uvec4(pixel, sampleIndex, dimB, seed),
-                           wiLocal, weight, pdf, q))
-      return;
-    if (GUIDING && gv.alpha > 0.0f) {
-      // The mixture's density, for the weight f cos / pdf and for MIS at the next hit.
-      float pdfB = guided ? bsdfPdf(SAMPLER, MODEL_ID, M.info.z, M.params, wo, wiLocal) : pdf;
-      float pdfMix = guideMixture(gv, toWorld(wiLocal, tt, bb, ns), pdfB);
-      if (!(pdfMix > 0.0f)) return;
-      weight *= pdf / pdfMix;
-      if (guided) q = min(1.0f, luminance(weight));
-      pdf = pdfMix;
-    }
-    vec3 wi = toWorld(wiLocal, tt, bb, ns);
-    // Reflection must stay above the geometric surface (else light leaks through it); refraction
-    // (only delta models transmit) must cross it, and leaves from the other side.
-    bool transmitted = wiLocal.z < 0.0f;
-    if (transmitted != (dot(wi, ng) < 0.0f)) return;
-    if (transmitted) xo = offsetRay(x, -ng);
-
-    // ---- Russian roulette: on the throughput (default), or with the continuation probability
-    // of the sample (the source's albedo roulette). Survivors are divided by the probability.
-    float uR = sample1(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_ROULETTE), seed);
-    if (roulette == ROULETTE_ALBEDO) {
-      if (!(q > 0.0f) || uR >= q) return;
-      beta *= weight / q;
-    } else {
-      beta *= weight;
-      if (transmitted) etaScale *= transmissionEtaScale(MODEL_ID, M.params, !frontFace);
-      if (!throughputRoulette(bounce, beta, etaScale, uR)) return;
-    }
-
-    if (GUIDING) guideRecordSample(path, bounce, wi, modelIsDelta(MODEL_ID) ? -1.0f : luminance(beta) * pdf);
-    g.pathOrigin.v[path] = vec4(xo, 0.0f);
-    g.pathDirection.v[path] = vec4(wi, pdf);
-    g.pathThroughput.v[path] = vec4(beta, etaScale);
-    queuePush(((bounce + 1u) & 1u), path);
-    return;
-  }
-
-#else
-  // ---- A combined material: sum_k w_k f_k (shaders/shared/combined.h, docs/models.md) ----
-  GpuComponent C0, C1, C2, C3;
-  vec4 a = vec4(0.0f);  // choice weights a_k = w_k A_k(wo), from wo only
-  uint first = M.components.x;
-  uint mode = combinedChoiceMode(g.componentChoice, roulette);
-  if (COMPONENT_COUNT > 0u) { C0 = g.components.v[first]; a.x = componentChoiceWeight(mode, SAMPLER, MODEL_0, C0, wo); }
-  if (COMPONENT_COUNT > 1u) { C1 = g.components.v[first + 1u]; a.y = componentChoiceWeight(mode, SAMPLER, MODEL_1, C1, wo); }
-  if (COMPONENT_COUNT > 2u) { C2 = g.components.v[first + 2u]; a.z = componentChoiceWeight(mode, SAMPLER, MODEL_2, C2, wo); }
-  if (COMPONENT_COUNT > 3u) { C3 = g.components.v[first + 3u]; a.w = componentChoiceWeight(mode, SAMPLER, MODEL_3, C3, wo); }
-  vec4 P = combinedChoiceProbabilities(mode, COMPONENT_COUNT, a);
-  vec4 c = combinedMisProbabilities(P);
-  // Delta components take no light samples and have no MIS density: their c is dropped below.
-  if (modelIsDelta(MODEL_0)) c.x = 0.0f;
-  if (modelIsDelta(MODEL_1)) c.y = 0.0f;
-  if (modelIsDelta(MODEL_2)) c.z = 0.0f;
-  if (modelIsDelta(MODEL_3)) c.w = 0.0f;
-
-  // ---- Next-event estimation: the sum of the non-delta components ----
-  if (!last && lighting != LIGHTING_BSDF_ONLY && (M.info.y & MATERIAL_DELTA) == 0u) {
-    float uSel = sample1(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_LIGHT_SELECT), seed);
-    vec2 uPt = sample2(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_LIGHT_POINT), seed);
-    LightSample ls;
-    if (sampleLight(xo, uSel, uPt, ls) && dot(ls.wi, ng) > 0.0f) {
-      vec3 wiL = toLocal(ls.wi, tt, bb, ns);
-      vec3 f = vec3(0.0f);
-      float pdfB = 0.0f;
-      if (COMPONENT_COUNT > 0u) { f += componentEval(MODEL_0, C0, wiL, wo); pdfB += componentMisPdf(MODEL_0, C0, c.x, wo, wiL); }
-      if (COMPONENT_COUNT > 1u) { f += componentEval(MODEL_1, C1, wiL, wo); pdfB += componentMisPdf(MODEL_1, C1, c.y, wo, wiL); }
-      if (COMPONENT_COUNT > 2u) { f += componentEval(MODEL_2, C2, wiL, wo); pdfB += componentMisPdf(MODEL_2, C2, c.z, wo, wiL); }
-      if (COMPONENT_COUNT > 3u) { f += componentEval(MODEL_3, C3, wiL, wo); pdfB += componentMisPdf(MODEL_3, C3, c.w, wo, wiL); }
-      float cosS = max(wiL.z, 0.0f);
-      vec3 contrib = beta * f * cosS * ls.value;
-      if (ls.pdf > 0.0f && lighting == LIGHTING_MIS) contrib *= powerHeuristic(ls.pdf, pdfB);
-      if (max(contrib.x, max(contrib.y, contrib.z)) > 0.0f) {
-        float tmax = ls.dist < 1.0e38f ? ls.dist * (1.0f - 1e-4f) : ls.dist;
-        g.shadowOrigin.v[path] = vec4(xo, tmax);
-        g.shadowDirection.v[path] = vec4(ls.wi, 0.0f);
-        g.shadowRadiance.v[path] = vec4(contrib, 0.0f);
-        queuePush(QUEUE_SHADOW, path);
-      }
-    }
-  }
+  ShadeMaterial m = shadeMaterial(M, x, wo, roulette);
+  if (!last && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m))
+    nextEvent(m, path, key, bounce, lighting, xo, ng, tt, bb, ns, wo, beta);
 
   g.pathRadiance.v[path].xyz += L;
   if (last) return;
 
-  // ---- Component choice (albedo mode under the albedo roulette: includes the roulette) ----
-  float uC = sample1(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_COMPONENT), seed);
-  uint k;
-  float pk;
-  if (!combinedPick(mode, COMPONENT_COUNT, a, uC, k, pk) || !(pk > 0.0f)) return;
-
-  // ---- Sample the chosen component ----
-  uint dimB = rngDimension(bounce, RNG_DIM_BSDF);
-  vec2 uB = sample2(rngMode, pixel, sampleIndex, dimB, seed);
-  uvec4 key = uvec4(pixel, sampleIndex, dimB, seed);
-  vec3 wiLocal = vec3(0.0f, 0.0f, 1.0f);
-  vec3 weight = vec3(0.0f);
-  float pdf = 0.0f;
-  float qk;  // the component's own continuation: not used (the choice above is the roulette)
-  bool ok = false;
-  bool delta = false;
-  float wk = 0.0f;
-  float etaK = 1.0f;  // transmissionEtaScale of the chosen component
-  if (COMPONENT_COUNT > 0u && k == 0u) {
-    ok = bsdfSample(SAMPLER, MODEL_0, C0.info.y, C0.params, wo, !frontFace, uB, key, wiLocal, weight, pdf, qk);
-    delta = modelIsDelta(MODEL_0);
-    wk = C0.data.x;
-    etaK = transmissionEtaScale(MODEL_0, C0.params, !frontFace);
-  }
-  if (COMPONENT_COUNT > 1u && k == 1u) {
-    ok = bsdfSample(SAMPLER, MODEL_1, C1.info.y, C1.params, wo, !frontFace, uB, key, wiLocal, weight, pdf, qk);
-    delta = modelIsDelta(MODEL_1);
-    wk = C1.data.x;
-    etaK = transmissionEtaScale(MODEL_1, C1.params, !frontFace);
-  }
-  if (COMPONENT_COUNT > 2u && k == 2u) {
-    ok = bsdfSample(SAMPLER, MODEL_2, C2.info.y, C2.params, wo, !frontFace, uB, key, wiLocal, weight, pdf, qk);
-    delta = modelIsDelta(MODEL_2);
-    wk = C2.data.x;
-    etaK = transmissionEtaScale(MODEL_2, C2.params, !frontFace);
-  }
-  if (COMPONENT_COUNT > 3u && k == 3u) {
-    ok = bsdfSample(SAMPLER, MODEL_3, C3.info.y, C3.params, wo, !frontFace, uB, key, wiLocal, weight, pdf, qk);
-    delta = modelIsDelta(MODEL_3);
-    wk = C3.data.x;
-    etaK = transmissionEtaScale(MODEL_3, C3.params, !frontFace);
-  }
-  if (!ok || !(wk > 0.0f)) return;
-  vec3 wi = toWorld(wiLocal, tt, bb, ns);
-  bool transmitted = wiLocal.z < 0.0f;
-  if (transmitted != (dot(wi, ng) < 0.0f)) return;
-  if (transmitted) xo = offsetRay(x, -ng);
-
-  // ---- Weight: w_k f_k cos / (P_k pdf_k); then the throughput roulette, or (albedo roulette)
-  // uniform mode's separate albedo roulette ----
-  float p = pk;
-  float uR = sample1(rngMode, pixel, sampleIndex, rngDimension(bounce, RNG_DIM_ROULETTE), seed);
-  if (roulette == ROULETTE_ALBEDO && mode == COMPONENTS_UNIFORM) {
-    float q = combinedUniformContinuation(a);
-    if (!(q > 0.0f) || uR >= q) return;
-    p *= q;
-  }
-  beta *= weight * (wk / p);
-  if (roulette != ROULETTE_ALBEDO) {
-    if (transmitted) etaScale *= etaK;
-    if (!throughputRoulette(bounce, beta, etaScale, uR)) return;
-  }
-
-  // MIS density of the sampled direction: sum over the non-delta components (0 after a delta lobe).
-  float misPdf = 0.0f;
-  if (!delta) {
-    if (COMPONENT_COUNT > 0u) misPdf += componentMisPdf(MODEL_0, C0, c.x, wo, wiLocal);
-    if (COMPONENT_COUNT > 1u) misPdf += componentMisPdf(MODEL_1, C1, c.y, wo, wiLocal);
-    if (COMPONENT_COUNT > 2u) misPdf += componentMisPdf(MODEL_2, C2, c.z, wo, wiLocal);
-    if (COMPONENT_COUNT > 3u) misPdf += componentMisPdf(MODEL_3, C3, c.w, wo, wiLocal);
-  }
-
-  // Combined materials are not guided yet: their vertices only train the guide.
-  if (GUIDING) guideRecordSample(path, bounce, wi, delta ? -1.0f : luminance(beta) * misPdf);
-  g.pathOrigin.v[path] = vec4(xo, 0.0f);
-  g.pathDirection.v[path] = vec4(wi, misPdf);
-  g.pathThroughput.v[path] = vec4(beta, etaScale);
-  queuePush(((bounce + 1u) & 1u), path);
-#endif
+  // ---- The next step of the random walk: the material's sample, then the roulette ----
+  float uR = pathSample1(key, rngDimension(bounce, RNG_DIM_ROULETTE));
+  PathStep s;
+  if (!shadeSample(m, key, bounce, roulette, wo, !frontFace, tt, bb, ns, uR, s)) return;
+  continuePath(s, path, bounce, roulette, x, xo, ng, tt, bb, ns, beta, etaScale, uR);
 }

@@ -8,8 +8,8 @@
 // Inputs: SampleToolConstants (count, first, seed, v) as push constants; in Globals the sampler's
 // tables and materials.v[0] = the material (info.z = its QuadSet, or its TabSet for tabulated). Outputs per sample i: film.v[i] = (w, pdf or 0 on failure),
 // filmSq.v[i] = (f rgb, 1 if the sample succeeded). Counters: stats (bound violations, trial
-// failures). Sample i uses rng2(i, 0, RNG_DIM_BSDF, seed) and the rejection stream of
-// (i, 0, RNG_DIM_BSDF, seed): the CPU reproduces it bit for bit up to float differences.
+// failures). Sample i uses u = rng2(i, 0, RNG_DIM_BSDF, seed) (and the quadtree the stream of u):
+// the CPU reproduces it bit for bit up to float differences.
 #include "shared/layout.h"
 #include "shared/bsdf_sampling.h"
 STAGE_PUSH(SampleToolConstants);
@@ -29,7 +29,7 @@ void main() {
   vec3 w;
   float pdf;
   vec3 f;
-  bool ok = strategySample(SAMPLER, MODEL_ID, M.info.z, M.params, v, u, uvec4(i, 0u, RNG_DIM_BSDF, seed), w, pdf, f);
+  bool ok = strategySample(SAMPLER, MODEL_ID, M.info.z, M.params, v, u, w, pdf, f);
   g.film.v[i] = vec4(w, ok ? pdf : 0.0f);
   g.filmSq.v[i] = vec4(f, ok ? 1.0f : 0.0f);
 }

@@ -34,7 +34,7 @@ SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint3
       vec2 u = rng2(i, 0u, RNG_DIM_BSDF, seed);
       vec3 w, f;
       float pdf;
-      bool ok = quadSample(set, model, params, v, u, uvec4(i, 0u, RNG_DIM_BSDF, seed), w, pdf, f);
+      bool ok = quadSample(set, model, params, v, u, w, pdf, f);
       out.wPdf[i] = vec4(w, ok ? pdf : 0.0f);
       out.fOk[i] = vec4(f, ok ? 1.0f : 0.0f);
     }
@@ -80,7 +80,7 @@ SampleBatch sampleCpuStrategy(std::uint32_t strategy, const sampling::TabulatedT
       vec2 u = rng2(i, 0u, RNG_DIM_BSDF, seed);
       vec3 w, f;
       float pdf;
-      bool ok = strategySample(strategy, model, set, params, v, u, uvec4(i, 0u, RNG_DIM_BSDF, seed), w, pdf, f);
+      bool ok = strategySample(strategy, model, set, params, v, u, w, pdf, f);
       out.wPdf[i] = vec4(w, ok ? pdf : 0.0f);
       out.fOk[i] = vec4(f, ok ? 1.0f : 0.0f);
     }

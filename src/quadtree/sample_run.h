@@ -1,6 +1,6 @@
 // sample_run.h: draw N directions with the generic sampler for one known direction, on the GPU
 // (stage sample_tool) or the CPU (the same shared code), for `nusselt sample` and the tests.
-// Sample i uses rng2(i, 0, RNG_DIM_BSDF, seed) and its rejection stream on both devices.
+// Sample i uses u = rng2(i, 0, RNG_DIM_BSDF, seed) (and the quadtree the stream of u) on both devices.
 #pragma once
 #include <cstdint>
 #include <vector>
