@@ -14,7 +14,7 @@
 
 namespace nusselt {
 
-// The catalogue: every model of the list in shaders/shared/brdf/models.h (docs/models.md).
+// The catalogue: every analytic model of the list in shaders/shared/brdf/models.h (docs/models.md).
 const std::vector<ModelSpec>& allModels();
 // Measured models (merl): not in allModels(), whose loops need parameter sets; found by findModel
 // and modelById like the others.

@@ -761,6 +761,7 @@ int runCli(int argc, char** argv) {
   CommandRunner run;
   registerSamplerCommands(app, *bench, run);
   registerPreviewCommand(app, run);
+  registerModelsCommand(app, run);
 
   try {
     app.parse(argc, argv);

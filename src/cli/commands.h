@@ -20,5 +20,7 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
 void registerBenchError(CLI::App& bench, CommandRunner& run);
 // `nusselt preview` (src/cli/preview.cpp).
 void registerPreviewCommand(CLI::App& app, CommandRunner& run);
+// `nusselt models` (src/cli/models_command.cpp).
+void registerModelsCommand(CLI::App& app, CommandRunner& run);
 
 }  // namespace nusselt

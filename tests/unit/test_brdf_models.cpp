@@ -488,47 +488,6 @@ TEST(BrdfModelEval, PoulinFournierMatchesBruteForce) {
   }
 }
 
-// Prints each model's parameter table in markdown ([doc] lines; docs/models.md is assembled from
-// them): name, kind, allowed range, typical and hard values.
-std::string valueText(const ParamValue& v) {
-  char buf[64];
-  switch (v.kind) {
-    case ParamValue::Kind::Number: std::snprintf(buf, sizeof buf, "%.6g", v.number); return buf;
-    case ParamValue::Kind::String: return v.text;
-    case ParamValue::Kind::Array: {
-      std::string r = "[";
-      for (size_t i = 0; i < v.items.size(); ++i) r += (i ? ", " : "") + valueText(v.items[i]);
-      return r + "]";
-    }
-  }
-  return "";
-}
-
-TEST(BrdfModelDocs, ParameterTables) {
-  auto find = [](const NamedParams& np, const std::string& name) -> std::string {
-    for (const auto& [n, v] : np)
-      if (n == name) return valueText(v);
-    return "(default)";
-  };
-  for (const ModelSpec& m : allModels()) {
-    std::printf("[doc] ### %s (id %u%s)\n[doc] %s\n[doc]\n", m.name.c_str(), m.id, m.delta ? ", delta" : "",
-                m.summary.c_str());
-    std::printf("[doc] | parameter | kind | allowed | typical (default) | hard | meaning |\n[doc] |---|---|---|---|---|---|\n");
-    for (const ParamSpec& p : m.params) {
-      const char* kind = p.kind == ParamKind::Colour ? "colour" : p.kind == ParamKind::Choice ? "choice"
-                         : p.kind == ParamKind::Lobes ? "lobes" : "scalar";
-      std::printf("[doc] | %s | %s | %s | %s | %s | %s |\n", p.name.c_str(), kind, describeRange(p).c_str(),
-                  find(m.typical, p.name).c_str(), find(m.hard, p.name).c_str(), p.doc.c_str());
-    }
-    for (const auto& [name, values] : m.variants) {
-      std::string t;
-      for (const auto& [n, v] : values) t += (t.empty() ? "" : ", ") + n + " = " + valueText(v);
-      std::printf("[doc] \n[doc] variant `%s`: %s\n", name.c_str(), t.c_str());
-    }
-    std::printf("[doc]\n");
-  }
-}
-
 // ---- Delta models -------------------------------------------------------------------------------
 
 TEST(BrdfModelDelta, EvalIsZeroAndFlagged) {
