@@ -15,10 +15,13 @@ glm::vec3 perpendicularTo(const glm::vec3& n) {
 }
 
 glm::vec3 orthonormalTangent(const glm::vec3& t, const glm::vec3& n) {
-  glm::dvec3 nd(n), td(t);
+  // n normalised in double: a float normal is unit only to ~1e-7, and for t (nearly) along n the
+  // residue of a non-unit n would dominate o and leave it far from orthogonal. A tangent within
+  // 1e-6 of the normal's direction has no usable part on the surface.
+  const glm::dvec3 nd = glm::normalize(glm::dvec3(n)), td(t);
   glm::dvec3 o = td - nd * glm::dot(nd, td);
   double len = glm::length(o);
-  if (!std::isfinite(len) || !(len > 1e-12 * glm::length(td))) return perpendicularTo(n);
+  if (!std::isfinite(len) || !(len > 1e-6 * glm::length(td))) return perpendicularTo(n);
   return glm::vec3(o / len);
 }
 
