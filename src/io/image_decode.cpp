@@ -10,6 +10,7 @@
 
 #include <csetjmp>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 #include "util/error.h"
@@ -70,6 +71,27 @@ void pngRead(png_structp png, png_bytep out, png_size_t n) {
 
 void pngWarn(png_structp, png_const_charp) {}  // benign (e.g. a bad ancillary chunk, skipped)
 
+// libpng allocates a chunk at its declared length before reading it, and Debian's build applies
+// no chunk cap to ancillary chunks such as iTXt: a 60-byte file declaring a 2 GB iTXt made it
+// allocate 2 GB (a fuzz finding; png_set_chunk_malloc_max did not stop it). Every allocation
+// libpng needs for an image we use is bounded by a chunk of the file (at most its size) or by a
+// row of the image (at most 8 bytes per pixel plus filter and alignment slack) plus the zlib
+// state; refuse anything larger. A refused ancillary chunk is skipped with a warning; a refused
+// critical one is a "corrupt" error.
+struct PngAllocBudget {
+  std::size_t fileSize;
+  png_infop info = nullptr;  // set once created; the width is known after IHDR
+};
+
+png_voidp pngMalloc(png_structp png, png_alloc_size_t n) {
+  const PngAllocBudget* budget = static_cast<const PngAllocBudget*>(png_get_mem_ptr(png));
+  const png_alloc_size_t width = budget->info ? png_get_image_width(png, budget->info) : 0;
+  const png_alloc_size_t cap = budget->fileSize + 16 * width + (png_alloc_size_t(1) << 20);
+  return n <= cap ? std::malloc(n) : nullptr;
+}
+
+void pngFree(png_structp, png_voidp p) { std::free(p); }
+
 struct PngHeader {
   png_uint_32 width, height;
   int bitDepth, colorType, sourceChannels;
@@ -119,11 +141,13 @@ struct PngHandles {
 
 DecodedImage decodePng(const std::uint8_t* bytes, std::size_t size, const ImageLimits& limits) {
   PngSource src{bytes, size, 0, {0}};
+  PngAllocBudget budget{size};
   PngHandles h;
-  h.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &src, &pngFail, &pngWarn);
+  h.png = png_create_read_struct_2(PNG_LIBPNG_VER_STRING, &src, &pngFail, &pngWarn, &budget, &pngMalloc, &pngFree);
   if (!h.png) throw Error("PNG: out of memory");
   h.info = png_create_info_struct(h.png);
   if (!h.info) throw Error("PNG: out of memory");
+  budget.info = h.info;
   png_set_read_fn(h.png, &src, &pngRead);
   // Text and unknown chunks are not needed: do not keep them (nor allocate for them).
   png_set_keep_unknown_chunks(h.png, PNG_HANDLE_CHUNK_NEVER, nullptr, 0);
