@@ -28,6 +28,7 @@
 #include "shared/rng.h"
 #include "shared/warp.h"
 #include "shared/texture.h"
+#include "shared/volume.h"
 
 // ---- The path's random numbers: the primary sample source (issue 19) ----------------------------
 // Every draw of a path goes through pathSample2 / pathSample1 (key, dimension), the dimensions of

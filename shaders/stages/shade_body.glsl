@@ -415,9 +415,14 @@ void main() {
   float etaScale = throughput.w;
   vec3 L = vec3(0.0f);
   if (GUIDING) guideRecordArrival(path, bounce, x);  // training record (guiding.h)
+  bool frontFace = dot(ngFront, dir) < 0.0f;
+
+  // ---- Beer-Lambert: a ray that meets an absorbing material from the back came from inside ----
+  // (shared/volume.h; docs/scenes.md, "Volumes"): the segment of length hit.x (dir is a unit
+  // vector) is attenuated before anything at this vertex counts.
+  if ((M.info.y & MATERIAL_ABSORBING) != 0u && !frontFace) beta *= volumeTransmittance(M.absorption.xyz, hit.x);
 
   // ---- Emission: one-sided emitters radiate along their geometric normal ----
-  bool frontFace = dot(ngFront, dir) < 0.0f;
   if ((M.info.y & MATERIAL_EMISSIVE) != 0u && frontFace) {
     float w = 1.0f;
     if (bounce > 0u && prevPdf > 0.0f) {  // reached by a BSDF sample that light sampling could also make
