@@ -18,6 +18,7 @@ MaterialTextureUse textureUse(const Material& m, const Scene& scene) {
   u.metallicRoughness = pbr && m.metallicRoughnessTexture.present();
   u.emissive = m.emits() && m.emissiveTexture.present();
   u.alpha = m.alphaMode != AlphaMode::Opaque;
+  u.transmission = m.transmissionTextured && m.transmissionTexture.present() && m.components.size() == 2;
   u.normal = m.normalTexture.present() && !scene.tangents.empty() && scene.tangents.size() == scene.positions.size();
   return u;
 }
@@ -76,12 +77,12 @@ GpuTexture packTexture(const TextureRef& ref, const TextureImage& image, std::ui
 }
 
 namespace {
-enum TextureSlot { SlotBaseColor, SlotMetallicRoughness, SlotEmissive, SlotNormal, SlotCoverage };
+enum TextureSlot { SlotBaseColor, SlotMetallicRoughness, SlotEmissive, SlotNormal, SlotCoverage, SlotTransmission };
 
 // Calls fn(material index, slot, reference, description) for every texture the renderer applies,
 // in the order of the texture records: per material (those a triangle uses), baseColor,
 // metallicRoughness, emissive, normal, then the coverage map (the base-colour texture read for
-// its alpha by a material whose base colour is not textured).
+// its alpha by a material whose base colour is not textured), then transmission.
 template <class F>
 void forEachAppliedTexture(const Scene& scene, F fn) {
   const std::vector<bool> used = usedMaterials(scene);
@@ -95,6 +96,7 @@ void forEachAppliedTexture(const Scene& scene, F fn) {
     if (u.normal) fn(i, SlotNormal, m.normalTexture, m.name + " normalTexture");
     if (u.alpha && m.baseColorTexture.present() && !u.baseColor)
       fn(i, SlotCoverage, m.baseColorTexture, m.name + " baseColorTexture (alpha)");
+    if (u.transmission) fn(i, SlotTransmission, m.transmissionTexture, m.name + " transmissionTexture");
   }
 }
 
@@ -132,6 +134,7 @@ TextureData buildTextureData(const Scene& scene) {
     g.baseColorFactor = m.baseColorFactor;
     g.factors = glm::vec4(m.metallicFactor, m.roughnessFactor, m.normalScale, m.alphaCutoff);
     g.alpha = glm::uvec4(static_cast<std::uint32_t>(m.alphaMode), INVALID_INDEX, 0u, 0u);
+    g.transmission = glm::uvec4(INVALID_INDEX, 0u, 0u, 0u);
   }
   forEachAppliedTexture(scene, [&](std::size_t i, TextureSlot slot, const TextureRef& ref, const std::string& what) {
     const TextureImage& image = appliedImage(scene, ref, what);
@@ -151,6 +154,7 @@ TextureData buildTextureData(const Scene& scene) {
       case SlotEmissive: g.maps.z = index; break;
       case SlotNormal: g.maps.w = index; break;
       case SlotCoverage: g.alpha.y = index; break;
+      case SlotTransmission: g.transmission.x = index; break;
     }
     // Coverage: the base-colour texture's alpha, for any model (its RGB applies to gltf_pbr only).
     if (slot == SlotBaseColor && textureUse(scene.materials[i], scene).alpha) g.alpha.y = index;

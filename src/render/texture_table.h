@@ -18,7 +18,8 @@ struct MaterialTextureUse {
   bool emissive = false;           // any material with a non-zero emission: RGB x emission
   bool normal = false;             // any material: the shading normal (needs Scene::tangents)
   bool alpha = false;              // any material: alphaMode MASK or BLEND (coverage in traversal)
-  bool any() const { return baseColor || metallicRoughness || emissive || normal || alpha; }
+  bool transmission = false;       // the transmission combination (Material::transmissionTextured)
+  bool any() const { return baseColor || metallicRoughness || emissive || normal || alpha || transmission; }
   // The BRDF's parameters (not only its emission) vary over the surface: no per-material
   // sampling tables fit it (the quadtree and tabulated samplers fall back to cosine).
   bool paramsVary() const { return baseColor || metallicRoughness; }

@@ -1337,26 +1337,30 @@ class Converter {
     if (!thin) m.absorption = shared::volumeAbsorption(m.attenuationColor, m.attenuationDistance);
     BrdfParams glass = packParams(glassModel, {{"eta", ParamValue::num(std::min(m.ior, 10.0f))}},
                                   context + " (transmission)");
-    if (w >= 1.0f) {
+    // A transmission texture varies w over the surface: the combination even where w = 1.
+    const bool textured = m.transmissionTexture.present();
+    if (w >= 1.0f && !textured) {
       m.model = glassModel.id;
       m.params = glass;
       return;
     }
     MaterialComponent base;
     base.model = MODEL_GLTF_PBR;
-    base.weight = 1.0f - w;
+    base.weight = std::max(0.0f, 1.0f - w);
     base.params = m.params;
     MaterialComponent clear;
     clear.model = glassModel.id;
     clear.weight = w;
     clear.params = glass;
     m.components = {base, clear};
+    m.transmissionTextured = textured;
   }
 
   // The textures the renderer does not apply yet (src/render/texture_table.h applies baseColor and
-  // metallicRoughness of gltf_pbr materials and every emissive and normal texture).
+  // metallicRoughness of gltf_pbr materials, every emissive and normal texture, and the
+  // transmission texture of the transmission combination).
   void warnUnrenderedTextures(const Material& m) {
-    if (m.transmissionTexture.present()) notRenderedYet("transmissionTexture");
+    if (m.transmissionTexture.present() && !m.transmissionTextured) notRenderedYet("transmissionTexture");
     if ((m.combined() || m.model != MODEL_GLTF_PBR) &&
         (m.baseColorTexture.present() || m.metallicRoughnessTexture.present()))
       notRenderedYet("baseColorTexture/metallicRoughnessTexture RGB of materials other than a single gltf_pbr "

@@ -86,6 +86,11 @@ struct Material {
   // KHR_materials_transmission: fraction of light transmitted (R channel of the texture).
   float transmissionFactor = 0.0f;
   TextureRef transmissionTexture;       // linear; R x transmissionFactor
+  // Set by the loader when transmissionTexture applies: the material is KHR_materials_transmission's
+  // combination {gltf_pbr, weight 1 - w; glass, weight w} (w = transmissionFactor x (1 - metallic);
+  // in that order, even for w = 1), and the renderer takes w x R (the texture's R at the hit) for
+  // the glass and 1 - w x R for gltf_pbr (docs/scenes.md, "Transmission").
+  bool transmissionTextured = false;
   // KHR_materials_ior (1.5 without the extension).
   float ior = 1.5f;
   // KHR_materials_volume. hasVolume false, or thicknessFactor 0: a thin-walled surface.

@@ -559,6 +559,30 @@ TEST(GltfTextures, TransmissionBecomesTheDielectric) {
   }
 }
 
+// transmissionTexture applies to the transmission combination: the material stays combined
+// {gltf_pbr, 1 - w; glass, w} even for w = 1, marked transmissionTextured (the renderer takes
+// w x R for the glass); without transmission (w = 0: a metal) it is named as not rendered.
+TEST(GltfTextures, TransmissionTextureKeepsTheCombination) {
+  Json j = texturedQuad();
+  j["extensionsUsed"] = {"KHR_materials_transmission"};
+  j["materials"][0] = Json::parse(R"({"name": "stained", "pbrMetallicRoughness": {"metallicFactor": 0},
+    "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"index": 0}}}})");
+  Scene s = loadJson(j);
+  const Material& m = s.materials[0];
+  ASSERT_EQ(m.components.size(), 2u);
+  EXPECT_TRUE(m.transmissionTextured);
+  EXPECT_EQ(m.components[0].model, MODEL_GLTF_PBR);
+  EXPECT_FLOAT_EQ(m.components[0].weight, 0.0f);
+  EXPECT_EQ(m.components[1].model, MODEL_THIN_DIELECTRIC);
+  EXPECT_FLOAT_EQ(m.components[1].weight, 1.0f);
+  EXPECT_FALSE(hasWarning(s, "transmissionTexture"));
+  j["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 1;
+  Scene metal = loadJson(j);
+  EXPECT_FALSE(metal.materials[0].transmissionTextured);
+  EXPECT_FALSE(metal.materials[0].combined());
+  EXPECT_TRUE(hasWarning(metal, "read but not rendered yet: transmissionTexture ("));
+}
+
 // KHR_materials_volume's attenuation in a refracting volume (thicknessFactor > 0, transmission):
 // Material::absorption = -ln(attenuationColor) / attenuationDistance per channel (volume.h), a
 // colour channel of 0 clamped to VOLUME_MAX_ABSORPTION, no attenuationDistance (or one beyond
