@@ -4,6 +4,8 @@
 #include <map>
 #include <set>
 
+#include "../../shaders/shared/alpha.h"
+#include "../../shaders/shared/texture.h"
 #include "util/error.h"
 
 namespace nusselt {
@@ -160,6 +162,37 @@ TextureData buildTextureData(const Scene& scene) {
     if (slot == SlotBaseColor && textureUse(scene.materials[i], scene).alpha) g.alpha.y = index;
   });
   return d;
+}
+
+shared::GpuTriTexcoords packTriTexcoords(const Scene& scene, std::uint32_t triangle) {
+  const bool has0 = scene.texcoords0.size() == scene.positions.size();
+  const bool has1 = scene.texcoords1.size() == scene.positions.size();
+  glm::vec2 a[3]{}, b[3]{};
+  for (std::uint32_t c = 0; c < 3; ++c) {
+    if (has0) a[c] = scene.texcoords0[3 * triangle + c];
+    if (has1) b[c] = scene.texcoords1[3 * triangle + c];
+  }
+  shared::GpuTriTexcoords t;
+  t.a = glm::vec4(a[0], a[1]);
+  t.b = glm::vec4(a[2], b[0]);
+  t.c = glm::vec4(b[1], b[2]);
+  return t;
+}
+
+AlphaTester::AlphaTester(const Scene& scene, const std::vector<std::uint32_t>& order)
+    : m_scene(scene), m_order(order), m_data(buildTextureData(scene)) {}
+
+bool AlphaTester::operator()(std::uint32_t tri, float b1, float b2, glm::vec3 origin, glm::vec3 dir) const {
+  const std::uint32_t src = m_order.empty() ? tri : m_order[tri];
+  const std::uint32_t material = m_scene.triangleMaterial[src];
+  // MATERIAL_ALPHA (material_table.cpp): a used material with alphaMode MASK or BLEND.
+  if (!textureUse(m_scene.materials[material], m_scene).alpha || m_data.materials.empty()) return true;
+  const GpuMaterialTextures& T = m_data.materials[material];
+  float alpha = T.baseColorFactor.w;
+  if (T.alpha.y != INVALID_INDEX)
+    alpha *= shared::textureAtHit(m_data.texels.data(), m_data.textures[T.alpha.y], packTriTexcoords(m_scene, src), b1,
+                                  b2).w;
+  return shared::alphaTest(T.alpha.x, alpha, T.factors.w, tri, origin, dir);
 }
 
 }  // namespace nusselt
