@@ -16,8 +16,9 @@ SHARED_BEGIN
 #define VOLUME_MAX_ABSORPTION 1e30f
 
 // sigma_a = -ln(c) / d per channel [1/m], c in [0, 1], d > 0 (the loader rejects anything else);
-// clamped to [0, VOLUME_MAX_ABSORPTION]. d = +inf (no attenuationDistance): 0.
+// clamped to [0, VOLUME_MAX_ABSORPTION]. d = +inf (no attenuationDistance): 0, whatever c.
 SHARED_FN float volumeAbsorption1(float c, float d) {
+  if (!isFinite(d)) return 0.0f;
   if (!(c > 0.0f)) return VOLUME_MAX_ABSORPTION;
   float s = -log(min(c, 1.0f)) / d;
   return s >= 0.0f ? min(s, VOLUME_MAX_ABSORPTION) : 0.0f;

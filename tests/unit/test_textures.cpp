@@ -615,6 +615,7 @@ TEST(GltfTextures, VolumeAttenuationBecomesTheAbsorptionCoefficient) {
   EXPECT_EQ(shared::volumeTransmittance(black.absorption, 1e-6f).x, 0.0f);
   EXPECT_EQ(shared::volumeTransmittance(black.absorption, 0.0f).x, 1.0f);
   for (const char* none : {R"({"thicknessFactor": 0.1, "attenuationColor": [0.5, 0.5, 0.5]})",
+                           R"({"thicknessFactor": 0.1, "attenuationColor": [0, 0, 0]})",
                            R"({"thicknessFactor": 0.1, "attenuationDistance": 1e300, "attenuationColor": [0.5, 0.5, 0.5]})"}) {
     const Material n = loadJson(glass(none)).materials[0];
     EXPECT_FALSE(n.absorbs()) << none;
