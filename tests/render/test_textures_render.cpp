@@ -651,6 +651,26 @@ TEST(TexturesRender, AbsorbingSlabTransmitsFresnelTimesBeerLambert) {
   expectImageMeanRgb(test::render(s, rs), expected);
 }
 
+// The same through the loader (issue 18's test): scenes/tests/glass_slab_tinted.gltf, the slab of
+// GlassSlabTransmitsAsFresnelPredicts with attenuationColor c = (0.8, 0.5, 0.2) at
+// attenuationDistance 0.2 = its thickness, seen straight down: one crossing transmits c, and the
+// image converges to (1 - R)^2 c / (1 - R^2 c^2) per channel, R = 0.04 (max depth 32 leaves out
+// R^30). z-test of the image mean per channel, significance 0.001 with Sidak over 3.
+TEST(TexturesRender, TintedGlassSlabFromGltfTransmitsFresnelTimesAttenuationColor) {
+  Scene s = test::loadTestScene("scenes/tests/glass_slab_tinted.gltf");
+  lookDown(s, 1.0f, 0.9f);
+  RenderSettings rs;
+  rs.width = rs.height = 16;
+  rs.spp = 64;
+  rs.maxDepth = 32;
+  rs.seed = 31;
+  const double R = 0.04;
+  const glm::dvec3 c(0.8, 0.5, 0.2);
+  glm::dvec3 expected;
+  for (int k = 0; k < 3; ++k) expected[k] = (1 - R) * (1 - R) * c[k] / (1 - R * R * c[k] * c[k]);
+  expectImageMeanRgb(test::render(s, rs), expected);
+}
+
 // KHR_materials_transmission's texture (transmissionTextured): a thin-walled sheet (the glTF
 // combination {gltf_pbr white, 1 - w; thin_dielectric eta 1.5, w}, w = 1) at z = 0.3 with a 2 x 1
 // NEAREST transmission texture, R = 255 over x < 0 and 64 over x > 0, over an emitter of
