@@ -77,6 +77,7 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 #define MATERIAL_COMBINED 4u  // a weighted sum of elementary BRDFs (GpuMaterial.components)
 #define MATERIAL_TEXTURED 8u  // a texture applies (Globals.materialTextures: GpuMaterialTextures)
 #define MATERIAL_ALPHA 16u    // alphaMode MASK or BLEND: hits are tested in traversal (trace.glsl)
+#define MATERIAL_ABSORBING 32u  // a refracting volume that absorbs (GpuMaterial.absorption; volume.h)
 
 // ---- Combined materials ---------------------------------------------------------------------------
 // At most this many components per material: the shade stage is specialised per tuple of component
@@ -149,13 +150,16 @@ STATIC_ASSERT_SIZE(BrdfParams, 128);
 // emission = emitted radiance (rgb), w unused.
 // components = (first GpuComponent, count, 0, 0) when MATERIAL_COMBINED (then info.x is the first
 // component's model and params/info.z are unused); (0, 0, 0, 0) otherwise.
+// absorption = the volume's absorption coefficient sigma_a [1/m] (rgb; volume.h), w unused; read
+// only when MATERIAL_ABSORBING.
 struct GpuMaterial {
   uvec4 info;
   vec4 emission;
   BrdfParams params;
   uvec4 components;
+  vec4 absorption;
 };
-STATIC_ASSERT_SIZE(GpuMaterial, 176);
+STATIC_ASSERT_SIZE(GpuMaterial, 192);
 
 // One term w * f_k of a combined material (shaders/shared/combined.h).
 // info = (model id, quadtree set index or INVALID_INDEX, 0, 0); data = (weight w, 0, 0, 0);
