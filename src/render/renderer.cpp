@@ -87,7 +87,9 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
                                                      m_settings.traversal == Traversal::RayQuery) + envBytes +
                                textureDeviceBytes(scene) + measured.size() * MERL_TABLE_FLOATS * sizeof(float) +
                                std::max<std::size_t>(scene.materials.size(), 1) * sizeof(shared::GpuMaterial) +
-                               Film::bytesFor(pixels) + PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS) +
+                               Film::bytesFor(pixels) +
+                               PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS,
+                                                        settings.primarySamples ? PathIntegrator::primaryDimsFor(settings.maxDepth) : 0) +
                                (settings.guiding ? DeviceGuide::bytesFor(settings.guideMemory, capacity, settings.maxDepth) : 0);
     const std::uint64_t have = vk::deviceLocalHeapSize(m_ctx);
     // The film is the largest single buffer (16 bytes per pixel, twice): one allocation each.
@@ -157,9 +159,12 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
     m_summary.guiding = true;
     m_summary.guideTrainSpp = guideTrainingSpp(settings);
   }
+  PathOptions paths;
+  if (settings.primarySamples) paths.primaryDims = PathIntegrator::primaryDimsFor(settings.maxDepth);
   auto integrator = std::make_unique<PathIntegrator>(m_ctx, *m_globals, m_settings, m_materials->slotKeys(), pixels,
-                                                     m_samplesPerPass, m_materials->slotNames(), m_guide.get());
+                                                     m_samplesPerPass, m_materials->slotNames(), m_guide.get(), paths);
   m_summary.pipelineSeconds = integrator->pipelineSeconds();
+  m_paths = integrator.get();
   m_integrator = std::move(integrator);
   m_globals->upload();
   m_summary.deviceBytes = m_scene->deviceBytes() + m_materials->deviceBytes() + m_film->deviceBytes() +

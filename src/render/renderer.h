@@ -49,6 +49,7 @@ struct SceneSummary {
 Traversal resolveTraversal(const vk::Context& ctx, Traversal requested);
 
 class DeviceGuide;
+class PathIntegrator;
 
 class Renderer {
  public:
@@ -90,6 +91,8 @@ class Renderer {
   // Path guiding's state (null for unguided renders): its training reports and times.
   const DeviceGuide* guide() const { return m_guide.get(); }
   const RenderSettings& settings() const { return m_settings; }
+  // The path tracer that traces this render's paths (tests read and write its path state).
+  PathIntegrator& paths() { return *m_paths; }
 
   // ---- Progressive use (the preview window) ----
   // Restart accumulation: the film is cleared and the sample index goes back to 0.
@@ -122,6 +125,7 @@ class Renderer {
   std::unique_ptr<Film> m_film;
   std::unique_ptr<DeviceGuide> m_guide;
   std::unique_ptr<Integrator> m_integrator;
+  PathIntegrator* m_paths = nullptr;  // m_integrator's path tracer
 };
 
 }  // namespace nusselt

@@ -153,6 +153,10 @@ struct RenderSettings {
   // splats in iteration k. Mueller et al.'s 12000 suits their 1280 x 720 images; small images
   // get few regions with it (docs/guiding.md, measurements).
   double guideSpatialThreshold = 12000;
+  // The path tracer reads every random number of a path from a primary sample vector in a buffer
+  // (PathOptions::primaryDims = PathIntegrator::primaryDimsFor(maxDepth); Renderer::paths()), which
+  // the caller fills: for tests of the primary sample source. Not a command-line option.
+  bool primarySamples = false;
 };
 
 // The training samples per pixel of a guided render: settings.guideTrainSpp, or when 0 the
