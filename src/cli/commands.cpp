@@ -51,6 +51,7 @@ struct RenderArgs {
   std::string components = "albedo";
   std::string roulette = "throughput";
   std::string traversal = "auto";
+  std::string integrator = "path";
   std::string guiding = "off";
   std::uint32_t guideTrain = 0;
   double guideMemoryMiB = 16;
@@ -91,11 +92,24 @@ int renderCommand(const RenderArgs& a) {
   parseComponentSelection(a.components, s.components);
   parseRouletteMode(a.roulette, s.roulette);
   parseTraversal(a.traversal, s.traversal);
+  if (!parseIntegrator(a.integrator, s.integrator))
+    throw Error("--integrator " + a.integrator + ": unknown integrator (path or mlt)");
   s.guiding = a.guiding == "on";
   s.guideTrainSpp = a.guideTrain;
   s.guideSpatialThreshold = a.guideSpatial;
   s.guideAlpha = a.guideAlpha;
   s.guideMemory = static_cast<std::uint64_t>(a.guideMemoryMiB * 1048576.0);
+  // What Metropolis renders do not support yet (docs/mlt.md): their chains live on the device
+  // only, so a file cannot continue them; guiding and the variance of a correlated estimate.
+  if (s.integrator == IntegratorKind::Mlt) {
+    if (!a.resume.empty())
+      throw Error("--resume with --integrator mlt: a Metropolis render cannot be resumed (its chains are not in the "
+                  "file; docs/mlt.md)");
+    if (s.guiding) throw Error("--integrator mlt with --guiding on: not supported (docs/mlt.md)");
+    if (a.variance)
+      throw Error("--variance with --integrator mlt: the Metropolis estimate has no per-sample variance (its samples "
+                  "are correlated; docs/mlt.md)");
+  }
   if (s.guiding && !a.resume.empty())
     throw Error("--resume with --guiding on: a guided render cannot be resumed yet (its guide is not in the file; "
                 "issue 16)");
@@ -194,13 +208,13 @@ int renderCommand(const RenderArgs& a) {
                      sum.samplerCacheMisses, sum.samplerCacheRejected);
       std::string budget = a.timeBudget > 0 ? ", time budget " + std::to_string(a.timeBudget) + " s" : "";
       std::fprintf(stderr, "device: %s (%s); %ux%u, %s spp%s%s (%u per pass), max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
-                           "roulette %s, traversal %s%s\n",
+                           "roulette %s, traversal %s, integrator %s%s\n",
                    ctx.deviceName.c_str(), ctx.driverInfo.c_str(), s.width, s.height,
                    targetSpp == (1u << 30) ? "unlimited" : std::to_string(targetSpp).c_str(),
                    a.resume.empty() ? "" : (" (resuming from " + std::to_string(previous.spp) + ")").c_str(),
                    budget.c_str(), renderer.samplesPerPass(), s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng),
                    samplerName(s.sampler), rouletteModeName(s.roulette), traversalName(sum.traversal),
-                   s.guiding ? (", guiding on (" + std::to_string(sum.guideTrainSpp) + " training spp)").c_str() : "");
+                   integratorName(s.integrator), s.guiding ? (", guiding on (" + std::to_string(sum.guideTrainSpp) + " training spp)").c_str() : "");
     }
 
     base.totalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();  // set-up
@@ -266,6 +280,8 @@ int mergeCommand(const std::vector<std::string>& inputs, const std::string& outp
     ImageMetadata meta;
     Image img = readExr(inputs[k], &meta);
     RenderRecord r = readRecord(inputs[k], meta);
+    if (r.settings.integrator == IntegratorKind::Mlt)
+      throw Error(inputs[k] + ": rendered with --integrator mlt; merging Metropolis renders is not supported (docs/mlt.md)");
     r.settings.width = static_cast<std::uint32_t>(img.width);
     r.settings.height = static_cast<std::uint32_t>(img.height);
     if (img.sum.empty() || img.sumSq.empty())
@@ -671,6 +687,9 @@ int runCli(int argc, char** argv) {
   render->add_option("--checkpoint", ra.checkpointSeconds, "Write the image so far to the output every this many seconds "
                                                           "(resumable with --resume; 0: never)")
       ->capture_default_str()->check(CLI::Range(0.0, 1e9));
+  render->add_option("--integrator", ra.integrator, "Integrator: path (the wavefront path tracer) or mlt (primary-"
+                                                   "sample-space Metropolis over it; docs/mlt.md)")
+      ->capture_default_str();
   render->add_option("--guiding", ra.guiding, "Path guiding (docs/guiding.md): on = sample directions from a guide "
                                               "learned from the render's first samples (one-sample MIS with the BSDF "
                                               "sampler), off = BSDF sampling only")

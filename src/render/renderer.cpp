@@ -55,6 +55,8 @@ Traversal resolveTraversal(const vk::Context& ctx, Traversal requested) {
 Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& settings)
     : m_ctx(ctx), m_settings(settings) {
   if (settings.width == 0 || settings.height == 0) throw Error("image size must be at least 1x1");
+  if (settings.integrator != IntegratorKind::Path)
+    throw Error(std::string("--integrator ") + integratorName(settings.integrator) + ": not available in this build yet");
   m_settings.traversal = resolveTraversal(ctx, settings.traversal);
   m_summary.traversal = m_settings.traversal;
   const std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;

@@ -92,6 +92,12 @@ enum class Traversal : std::uint32_t { Auto, RayQuery, Bvh };
 inline constexpr EnumName<Traversal> kTraversalNames[] = {
     {Traversal::Auto, "auto"}, {Traversal::RayQuery, "rayquery"}, {Traversal::Bvh, "bvh"}};
 
+// The integrator of a render (`--integrator`): path = the wavefront path tracer; mlt = primary
+// sample space Metropolis light transport over it (issue 19, docs/mlt.md). Not a shader value.
+enum class IntegratorKind : std::uint32_t { Path, Mlt };
+inline constexpr EnumName<IntegratorKind> kIntegratorNames[] = {{IntegratorKind::Path, "path"},
+                                                                {IntegratorKind::Mlt, "mlt"}};
+
 inline const char* lightingModeName(LightingMode m) { return enumName(kLightingNames, m); }
 inline const char* samplerName(SamplerKind k) { return enumName(kSamplerNames, k); }
 inline const char* rngModeName(RngMode m) { return enumName(kRngNames, m); }
@@ -106,8 +112,11 @@ inline bool parseComponentSelection(const std::string& name, ComponentSelection&
 inline bool parseRouletteMode(const std::string& name, RouletteMode& m) { return parseEnum(kRouletteNames, name, m); }
 inline const char* traversalName(Traversal t) { return enumName(kTraversalNames, t); }
 inline bool parseTraversal(const std::string& name, Traversal& t) { return parseEnum(kTraversalNames, name, t); }
+inline const char* integratorName(IntegratorKind k) { return enumName(kIntegratorNames, k); }
+inline bool parseIntegrator(const std::string& name, IntegratorKind& k) { return parseEnum(kIntegratorNames, name, k); }
 
 struct RenderSettings {
+  IntegratorKind integrator = IntegratorKind::Path;
   std::uint32_t width = 512;
   std::uint32_t height = 512;
   std::uint32_t spp = 64;
