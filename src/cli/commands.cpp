@@ -20,6 +20,7 @@
 #include "io/image.h"
 #include "quadtree/sampler_tables.h"
 #include "render/guide.h"
+#include "render/mlt_integrator.h"
 #include "render/render_loop.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
@@ -52,6 +53,10 @@ struct RenderArgs {
   std::string roulette = "throughput";
   std::string traversal = "auto";
   std::string integrator = "path";
+  std::uint32_t mltChains = 65536;
+  std::uint32_t mltBootstrap = 0;
+  float mltLargeStep = 0.3f;
+  float mltSigma = 0.01f;
   std::string guiding = "off";
   std::uint32_t guideTrain = 0;
   double guideMemoryMiB = 16;
@@ -94,6 +99,10 @@ int renderCommand(const RenderArgs& a) {
   parseTraversal(a.traversal, s.traversal);
   if (!parseIntegrator(a.integrator, s.integrator))
     throw Error("--integrator " + a.integrator + ": unknown integrator (path or mlt)");
+  s.mltChains = a.mltChains;
+  s.mltBootstrap = a.mltBootstrap;
+  s.mltLargeStep = a.mltLargeStep;
+  s.mltSigma = a.mltSigma;
   s.guiding = a.guiding == "on";
   s.guideTrainSpp = a.guideTrain;
   s.guideSpatialThreshold = a.guideSpatial;
@@ -237,6 +246,15 @@ int renderCommand(const RenderArgs& a) {
                      r.dirThreshold, r.capped ? ", memory cap reached" : "");
       std::fprintf(stderr, "guiding: %u training spp, %.3f s of CPU time reading records, splatting and refining\n",
                    renderer.summary().guideTrainSpp, guide->trainingSeconds());
+    }
+    if (const MltIntegrator* mlt = renderer.mlt(); mlt && !a.quiet) {
+      const MltReport& m = mlt->report();
+      std::fprintf(stderr, "mlt: %u chains of %u primary draws; bootstrap %u paths (%llu with f > 0), b = %.6g, in %.2f s; "
+                           "%llu mutations, acceptance %.1f %% (large steps %.1f %% of them, accepted %.1f %%)\n",
+                   m.chains, m.dims, m.bootstrapPaths, static_cast<unsigned long long>(m.nonzeroBootstrap), m.b,
+                   m.bootstrapSeconds, static_cast<unsigned long long>(m.proposals), 100.0 * m.acceptance(),
+                   m.proposals ? 100.0 * double(m.largeProposals) / double(m.proposals) : 0.0,
+                   m.largeProposals ? 100.0 * double(m.largeAccepted) / double(m.largeProposals) : 0.0);
     }
     if (rec.interrupted)
       std::fprintf(stderr, "interrupted by %s after %u of %u spp: writing what has accumulated\n",
@@ -690,6 +708,15 @@ int runCli(int argc, char** argv) {
   render->add_option("--integrator", ra.integrator, "Integrator: path (the wavefront path tracer) or mlt (primary-"
                                                    "sample-space Metropolis over it; docs/mlt.md)")
       ->capture_default_str();
+  render->add_option("--mlt-chains", ra.mltChains, "mlt: Markov chains in flight (each a path per mutation)")
+      ->capture_default_str()->check(CLI::Range(64u, 4194240u));
+  render->add_option("--mlt-bootstrap", ra.mltBootstrap, "mlt: independent bootstrap paths for the normalisation and "
+                                                         "the chains' starts (0: 4 x chains)")
+      ->capture_default_str();
+  render->add_option("--mlt-large-step", ra.mltLargeStep, "mlt: probability of a large step (an independent path)")
+      ->capture_default_str()->check(CLI::Range(0.0f, 1.0f));
+  render->add_option("--mlt-sigma", ra.mltSigma, "mlt: standard deviation of a small step per primary coordinate")
+      ->capture_default_str()->check(CLI::Range(1e-6f, 1.0f));
   render->add_option("--guiding", ra.guiding, "Path guiding (docs/guiding.md): on = sample directions from a guide "
                                               "learned from the render's first samples (one-sample MIS with the BSDF "
                                               "sampler), off = BSDF sampling only")

@@ -54,7 +54,7 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
       m_options(options) {
   for (std::size_t s = 0; s < m_slotKeys.size(); ++s)
     m_shadeMarks.push_back("shade " + (s < slotNames.size() ? slotNames[s] : std::to_string(s)));
-  m_capacity = capacityFor(settings, pixels, samplesPerPass);
+  m_capacity = options.capacity ? options.capacity : capacityFor(settings, pixels, samplesPerPass);
   const std::uint64_t cap = m_capacity;
   auto make = [&](VkDeviceSize bytes, const std::string& what, VkBufferUsageFlags usage = 0,
                   bool host = false) -> vk::Buffer* {
@@ -145,7 +145,9 @@ void PathIntegrator::createPipelines() {
   // Constant 11 (stage_common.glsl): PRIMARY_SAMPLES, in the stages that draw a path's numbers
   // (camera, shade, escape) when the paths read primary sample vectors.
   const std::uint32_t primary = m_options.primaryDims ? 1u : 0u;
-  if (primary) m_camera = vk::createComputePipeline(m_ctx, layout, "camera", {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, primary});
+  if (primary)
+    m_camera = vk::createComputePipeline(m_ctx, layout, "camera",
+                                         {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, primary, m_options.imageSamples ? 1u : 0u});
   else m_camera = vk::createComputePipeline(m_ctx, layout, "camera");
   m_submit = vk::createComputePipeline(m_ctx, layout, "submit");
   // The tracing stages' module for the traversal (the Renderer resolved Auto): <stage>_rq with ray
@@ -233,7 +235,7 @@ void PathIntegrator::dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, s
   vk::computeBarrier(cmd);
 }
 
-void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
+void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, bool accumulate) {
   const std::uint32_t slots = static_cast<std::uint32_t>(m_slotKeys.size());
   const VkPipelineLayout layout = m_globals.layout();
   const VkDescriptorSet set = m_globals.set();
@@ -295,6 +297,7 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
     vk::computeBarrier(cmd);
     mark(cmd, "shadow");
   }
+  if (!accumulate) return;
   bindAndPush(m_accumulate);
   vkCmdDispatch(cmd, groups, 1, 1);
   vk::computeBarrier(cmd);
@@ -341,12 +344,16 @@ void PathIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples
     }
     // Path guiding's training: this chunk's records and final radiance, splatted in path order.
     if (m_guide && m_guide->recording()) m_guide->consumeChunk(*m_pathRadiance, count);
-    // Fold the 32-bit device counters into 64-bit totals and restart them.
-    std::uint32_t* s = static_cast<std::uint32_t*>(m_stats->mapped);
-    m_totals.addDevice(s);
-    for (std::uint32_t b = 0; b < STAT_BOUNCE_SLOTS; ++b) m_raysPerBounce[b] += s[STAT_PER_BOUNCE + b];
-    std::memset(s, 0, STAT_BUFFER_UINTS * 4);
+    foldStats();
   }
+}
+
+void PathIntegrator::foldStats() {
+  // Fold the 32-bit device counters into 64-bit totals and restart them.
+  std::uint32_t* s = static_cast<std::uint32_t*>(m_stats->mapped);
+  m_totals.addDevice(s);
+  for (std::uint32_t b = 0; b < STAT_BOUNCE_SLOTS; ++b) m_raysPerBounce[b] += s[STAT_PER_BOUNCE + b];
+  std::memset(s, 0, STAT_BUFFER_UINTS * 4);
 }
 
 void PathIntegrator::addStats(const RenderStats& c) { m_totals.add(c); }

@@ -23,6 +23,11 @@ struct PathOptions {
   // primaryDims 2-D draws from primarySamples() (i * primaryDims + dimension): a path is then a
   // function of that vector (primaryDimsFor covers every draw of a path).
   std::uint32_t primaryDims = 0;
+  // With primaryDims: draw 0 places the camera ray anywhere on the image and the path's pixel
+  // follows from it (camera constant 12, IMAGE_SAMPLES; Metropolis chains move across pixels).
+  bool imageSamples = false;
+  // Path slots (paths per chunk); 0: capacityFor(settings, pixels, samplesPerPass).
+  std::uint32_t capacity = 0;
 };
 
 class PathIntegrator : public Integrator {
@@ -51,6 +56,12 @@ class PathIntegrator : public Integrator {
   static std::uint32_t primaryDimsFor(std::uint32_t maxDepth);
 
   void renderPass(std::uint32_t sampleIndex, std::uint32_t samples) override;
+  // For integrators that drive the path tracer (mlt): records the tracing of path slots
+  // 0 .. paths - 1 (camera and bounces, no accumulation into the film) into cmd, with the globals
+  // the caller uploaded (chunkFirst 0, chunkPaths = paths, passSamples 1); after the submission
+  // has completed, foldStats() adds its counters to stats().
+  void recordTrace(VkCommandBuffer cmd, std::uint32_t paths) { recordPass(cmd, paths, false); }
+  void foldStats();
   RenderStats stats() const override { return m_totals; }
   void addStats(const RenderStats& carried) override;
   const std::vector<std::pair<std::string, double>>& stageSeconds() const override { return m_stageSeconds; }
@@ -66,7 +77,7 @@ class PathIntegrator : public Integrator {
 
  private:
   void createPipelines();
-  void recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount);
+  void recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, bool accumulate = true);
   void dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst, std::uint32_t zeroCount,
                       std::uint32_t argsFirst, std::uint32_t argsCount, std::uint32_t bounce = 0);
   void mark(VkCommandBuffer cmd, const char* stage);

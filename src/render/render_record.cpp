@@ -112,6 +112,12 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
   // before); "nusselt/integrator" describes it.
   if (r.settings.integrator != IntegratorKind::Path) {
     meta.strings.push_back({"nusselt/integratorName", integratorName(r.settings.integrator)});
+    if (r.settings.integrator == IntegratorKind::Mlt) {
+      meta.ints.push_back({"nusselt/mltChains", r.settings.mltChains});
+      meta.ints.push_back({"nusselt/mltBootstrap", mltBootstrapPaths(r.settings)});
+      meta.doubles.push_back({"nusselt/mltLargeStep", r.settings.mltLargeStep});
+      meta.doubles.push_back({"nusselt/mltSigma", r.settings.mltSigma});
+    }
     for (auto& [name, value] : meta.strings)
       if (name == "nusselt/integrator")
         value = "primary-sample-space Metropolis (PSSMLT) over the wavefront path tracer (" + value + ")";
@@ -182,6 +188,12 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   // Absent in path-traced renders (and files written before other integrators existed).
   if (!parseIntegrator(findString(meta, "nusselt/integratorName").value_or("path"), r.settings.integrator))
     throw Error(path + ": header attribute nusselt/integratorName names an unknown integrator");
+  if (r.settings.integrator == IntegratorKind::Mlt) {
+    r.settings.mltChains = static_cast<std::uint32_t>(findInt(meta, "nusselt/mltChains").value_or(0));
+    r.settings.mltBootstrap = static_cast<std::uint32_t>(findInt(meta, "nusselt/mltBootstrap").value_or(0));
+    r.settings.mltLargeStep = static_cast<float>(findDouble(meta, "nusselt/mltLargeStep").value_or(0.3));
+    r.settings.mltSigma = static_cast<float>(findDouble(meta, "nusselt/mltSigma").value_or(0.01));
+  }
   // Absent in unguided renders (and files written before guiding existed).
   r.settings.guiding = findString(meta, "nusselt/guiding").value_or("off") == "on";
   r.settings.guideTrainSpp = static_cast<std::uint32_t>(findInt(meta, "nusselt/guideTrainSpp").value_or(0));

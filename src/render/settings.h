@@ -166,7 +166,22 @@ struct RenderSettings {
   // (PathOptions::primaryDims = PathIntegrator::primaryDimsFor(maxDepth); Renderer::paths()), which
   // the caller fills: for tests of the primary sample source. Not a command-line option.
   bool primarySamples = false;
+  // Metropolis (--integrator mlt, docs/mlt.md). Chains in flight (`--mlt-chains`; each a path slot
+  // and a primary sample vector of PathIntegrator::primaryDimsFor(maxDepth) draws).
+  std::uint32_t mltChains = 65536;
+  // Independent paths of the bootstrap (`--mlt-bootstrap`): the normalisation b and the chains'
+  // starts come from them; 0 = 4 x chains.
+  std::uint32_t mltBootstrap = 0;
+  // Probability of a large step (`--mlt-large-step`; Kelemen et al. and pbrt: 0.3).
+  float mltLargeStep = 0.3f;
+  // Standard deviation of a small step's move per coordinate (`--mlt-sigma`; pbrt: 0.01).
+  float mltSigma = 0.01f;
 };
+
+// The bootstrap paths of a Metropolis render (RenderSettings::mltBootstrap resolved).
+inline std::uint32_t mltBootstrapPaths(const RenderSettings& s) {
+  return s.mltBootstrap ? s.mltBootstrap : static_cast<std::uint32_t>(std::min<std::uint64_t>(4ull * s.mltChains, 1u << 30));
+}
 
 // The training samples per pixel of a guided render: settings.guideTrainSpp, or when 0 the
 // largest 2^K - 1 <= min(spp / 2, 127) (complete doubling iterations, at most half of the
