@@ -142,7 +142,8 @@ void MltIntegrator::bootstrap() {
     dispatch(cmd, MLT_KERNEL_RECORD, count);
     submit(cmd);
   }
-  std::vector<float> f(m_poolSize);
+  std::vector<float>& f = m_poolValues;
+  f.resize(m_poolSize);
   vk::downloadBuffer(m_ctx, *m_poolF, f.data(), std::uint64_t(m_poolSize) * 4);
   // b and the cumulative sums in double, in pool order (deterministic).
   std::vector<double> cdf(m_poolSize + 1, 0.0);

@@ -62,6 +62,8 @@ class MltIntegrator : public Integrator {
   std::uint64_t deviceBytes() const override;
   PathIntegrator& paths() { return *m_paths; }
   const MltReport& report() const { return m_report; }
+  // f (luminance of L) of every bootstrap path, in pool order (after the first pass; tests).
+  const std::vector<float>& bootstrapValues() const { return m_poolValues; }
 
  private:
   void bootstrap();
@@ -79,6 +81,7 @@ class MltIntegrator : public Integrator {
   std::uint32_t m_chains = 0, m_dims = 0, m_poolSize = 0;
   bool m_bootstrapped = false;
   MltReport m_report;
+  std::vector<float> m_poolValues;
   std::vector<vk::Buffer> m_buffers;
   vk::Buffer* m_mlt = nullptr;  // the GpuMlt (host visible)
   vk::Buffer* m_poolF = nullptr;
