@@ -242,7 +242,7 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer Environment
 // pool = (first pool path of this bootstrap chunk, paths in it, pool size, 0);
 // params = (large-step probability, small-step sigma, resolve scale (b x pixels / chains /
 // MLT_FIXED_SCALE), iterations in this pass (the film's sample count)).
-// current: chains x dims vec2 (each chain's current vector); state: per chain (its current
+// current: dims planes of chains vec2 (draw d of chain c at d x chains + c: its current vector); state: per chain (its current
 // radiance L (rgb), its pixel as float bits); splats: per pixel 6 uints (r, g, b: low, high);
 // poolF: f of every bootstrap path; start: the pool path each chain starts from; counters:
 // MLT_COUNTERS uints, per pass.

@@ -22,7 +22,7 @@ std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t dims, 
 
 std::uint32_t MltIntegrator::iterationsPerPassFor(const RenderSettings& s) {
   if (s.samplesPerPass) return s.samplesPerPass;
-  return std::max<std::uint32_t>(1, (1u << 20) / std::max<std::uint32_t>(s.mltChains, 1));
+  return std::max<std::uint32_t>(1, (1u << 18) / std::max<std::uint32_t>(s.mltChains, 1));
 }
 
 MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,

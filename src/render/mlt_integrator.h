@@ -48,8 +48,9 @@ class MltIntegrator : public Integrator {
 
   // Device bytes of the chains' state beyond the path tracer's.
   static std::uint64_t bytesFor(std::uint32_t chains, std::uint32_t dims, std::uint32_t bootstrap, std::uint64_t pixels);
-  // Mutations per chain per pass when RenderSettings::samplesPerPass is 0: about 2^20 paths per
-  // pass, at least 1.
+  // Mutations per chain per pass when RenderSettings::samplesPerPass is 0: about 2^18 paths per
+  // pass (the path tracer's count on a CPU device: a time budget ends within a few seconds on
+  // lavapipe), at least 1.
   static std::uint32_t iterationsPerPassFor(const RenderSettings& settings);
 
   // `samples` iterations (one mutation of every chain each), iterations sampleIndex ..

@@ -30,11 +30,13 @@ TEST(PrimaryRender, SameVectorSamePathOtherVectorOtherPath) {
   ASSERT_GE(paths.capacity(), slots);
   // Even pixels: both samples read the same vector; odd pixels: two independent vectors.
   std::mt19937 prng(11);
-  std::vector<float> u(std::size_t(slots) * dims * 2);
-  for (float& x : u) x = float(prng() >> 8) * (1.0f / 16777216.0f);
+  // Draw d of slot i at d x capacity + i (one plane per dimension).
+  const std::uint32_t capacity = paths.capacity();
+  std::vector<glm::vec2> u(std::size_t(capacity) * dims);
+  for (glm::vec2& x : u) x = glm::vec2(float(prng() >> 8), float(prng() >> 8)) * (1.0f / 16777216.0f);
   for (std::uint32_t p = 0; p < pixels; p += 2)
-    std::memcpy(&u[std::size_t(2 * p + 1) * dims * 2], &u[std::size_t(2 * p) * dims * 2], dims * 8);
-  vk::uploadBuffer(test::context(), paths.primarySamples(), u.data(), u.size() * 4);
+    for (std::uint32_t d = 0; d < dims; ++d) u[std::size_t(d) * capacity + 2 * p + 1] = u[std::size_t(d) * capacity + 2 * p];
+  vk::uploadBuffer(test::context(), paths.primarySamples(), u.data(), u.size() * 8);
   r.renderPass(2);
   std::vector<glm::vec4> L(slots);
   vk::downloadBuffer(test::context(), paths.pathRadiance(), L.data(), slots * 16);
