@@ -33,5 +33,17 @@ expect_error mlt_resume "cannot be resumed" -- --integrator mlt --resume "$work/
 expect_error mlt_guiding "not supported" -- --integrator mlt --guiding on
 expect_error mlt_variance "no per-sample variance" -- --integrator mlt --variance
 
+# An mlt render: its header names it; merging it is refused; resuming it with path is refused.
+"$nusselt" render -o "$work/mlt.exr" "${small[@]}" --integrator mlt --mlt-chains 1024 --spp 2 || fail "mlt render"
+[ "$("$nusselt" info "$work/mlt.exr" | sed -n 's/^  nusselt\/integratorName: //p')" = mlt ] || fail "mlt header"
+"$nusselt" render -o "$work/mlt2.exr" "${small[@]}" --integrator mlt --mlt-chains 1024 --spp 2 --spp-offset 2 || fail "mlt render 2"
+if "$nusselt" merge "$work/mlt.exr" "$work/mlt2.exr" -o "$work/merged.exr" 2>"$work/err"; then fail "merge of mlt renders"
+elif ! grep -qF "merging Metropolis renders is not supported" "$work/err"; then fail "merge message: $(cat "$work/err")"
+else echo "ok   mlt_merge: $(cat "$work/err")"; fi
+cp "$work/mlt.exr" "$work/resume.exr"
+if "$nusselt" render "${small[@]}" --resume "$work/resume.exr" --spp 4 2>"$work/err"; then fail "path resume of an mlt render"
+elif ! grep -qF "integrator" "$work/err"; then fail "resume message: $(cat "$work/err")"
+else echo "ok   mlt_resume_as_path: $(cat "$work/err")"; fi
+
 [ $fails -eq 0 ] && echo "all integrator checks passed"
 exit $((fails > 0))
