@@ -242,7 +242,7 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer Environment
 // pool = (first pool path of this bootstrap chunk, paths in it, pool size, 0);
 // params = (large-step probability, small-step sigma, resolve scale (b x pixels / chains /
 // MLT_FIXED_SCALE), iterations in this pass (the film's sample count)).
-// current: dims planes of chains vec2 (draw d of chain c at d x chains + c: its current vector); state: per chain (its current
+// current: the chains' current vectors (primarySampleIndex(c, d, dims)); state: per chain (its current
 // radiance L (rgb), its pixel as float bits); splats: per pixel 6 uints (r, g, b: low, high);
 // poolF: f of every bootstrap path; start: the pool path each chain starts from; counters:
 // MLT_COUNTERS uints, per pass.
@@ -413,6 +413,18 @@ STATIC_ASSERT_SIZE(TraceToolConstants, 16);
 layout(set = 0, binding = 0, std430) readonly buffer GlobalsBlock { Globals g; };
 #define STAGE_PUSH(T) layout(push_constant, std430) uniform PushBlock { T pc; }
 #endif
+
+// Where draw `dimension` of path slot `path` lives in Globals.primarySamples (and a Metropolis
+// chain's current vector, GpuMlt.current) of `dims` draws per path: blocks of 8 paths (a
+// subgroup on lavapipe), each block's draws one after the other, the 8 paths' values of a draw
+// side by side. Neighbouring lanes read neighbouring memory and one lane's draws stay within a
+// few KiB (one plane per dimension thrashed the TLB: 2-3x slower mutations on lavapipe).
+// A buffer holds primarySampleSlots(capacity) x dims vec2.
+#define PRIMARY_BLOCK 8u
+SHARED_FN uint primarySampleIndex(uint path, uint dimension, uint dims) {
+  return ((path / PRIMARY_BLOCK) * dims + dimension) * PRIMARY_BLOCK + path % PRIMARY_BLOCK;
+}
+SHARED_FN uint primarySampleSlots(uint capacity) { return (capacity + PRIMARY_BLOCK - 1u) / PRIMARY_BLOCK * PRIMARY_BLOCK; }
 
 SHARED_FN float brdfParam(BrdfParams p, uint i) { return p.v[i / 4u][i % 4u]; }
 SHARED_FN vec3 brdfParam3(BrdfParams p, uint i) {

@@ -4,8 +4,8 @@
 // one per pipeline (constant 13, MLT_KERNEL_*), around the path tracer's stages, which trace the
 // vectors these kernels put into the path slots (g.primarySamples) and leave each slot's radiance
 // in g.pathRadiance and its pixel in g.pathInfo.x. One invocation per chain (or bootstrap path, or
-// pixel for the resolve). Vectors are stored one plane per dimension (draw d of chain c at
-// d x chains + c, as the path tracer reads them): neighbouring lanes touch neighbouring memory.
+// pixel for the resolve). Vectors are stored as the path tracer reads them (layout.h,
+// primarySampleIndex).
 #include "shared/stage_common.glsl"
 #include "shared/mlt.h"
 
@@ -53,19 +53,20 @@ void main() {
   if (MLT_KERNEL == MLT_KERNEL_POOL || MLT_KERNEL == MLT_KERNEL_START) {
     if (c >= (MLT_KERNEL == MLT_KERNEL_POOL ? m.pool.y : chains)) return;
     uint i = MLT_KERNEL == MLT_KERNEL_POOL ? m.pool.x + c : m.start.v[c];
-    for (uint d = 0u; d < dims; ++d) primary.v[d * chains + c] = mltPoolSample(i, d, g.seed);
+    for (uint d = 0u; d < dims; ++d) primary.v[primarySampleIndex(c, d, dims)] = mltPoolSample(i, d, g.seed);
   } else if (MLT_KERNEL == MLT_KERNEL_RECORD) {
     if (c >= m.pool.y) return;
     m.poolF.v[m.pool.x + c] = luminance(tracedRadiance(c));
   } else if (MLT_KERNEL == MLT_KERNEL_ADOPT) {
     if (c >= chains) return;
-    for (uint d = 0u; d < dims; ++d) m.current.v[d * chains + c] = primary.v[d * chains + c];
+    for (uint d = 0u; d < dims; ++d) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];
     m.state.v[c] = vec4(tracedRadiance(c), uintBitsToFloat(g.pathInfo.v[c].x));
   } else if (MLT_KERNEL == MLT_KERNEL_MUTATE) {
     if (c >= chains) return;
     bool large = mltUnit(mltHash(c, iteration, MLT_DIM_STEP, g.seed).x) < m.params.x;
     for (uint d = 0u; d < dims; ++d)
-      primary.v[d * chains + c] = mltPropose(m.current.v[d * chains + c], mltHash(c, iteration, d, g.seed), large, m.params.y);
+      primary.v[primarySampleIndex(c, d, dims)] =
+          mltPropose(m.current.v[primarySampleIndex(c, d, dims)], mltHash(c, iteration, d, g.seed), large, m.params.y);
   } else if (MLT_KERNEL == MLT_KERNEL_ACCEPT) {
     bool live = c < chains;
     bool large = false, accepted = false;
@@ -84,7 +85,7 @@ void main() {
       if (fc > 0.0f && a < 1.0f) splat(m, floatBitsToUint(state.w), Lc * ((1.0f - a) / fc));
       accepted = mltUnit(h.y) < a;
       if (accepted) {
-        for (uint d = 0u; d < dims; ++d) m.current.v[d * chains + c] = primary.v[d * chains + c];
+        for (uint d = 0u; d < dims; ++d) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];
         m.state.v[c] = vec4(Lp, uintBitsToFloat(pp));
       }
     }

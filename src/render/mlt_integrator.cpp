@@ -17,7 +17,8 @@ using shared::Globals;
 std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t dims, std::uint32_t bootstrap,
                                       std::uint64_t pixels) {
   // Current vectors, states, start indices; splat sums; the bootstrap's f values; GpuMlt, counters.
-  return std::uint64_t(chains) * (dims * 8ull + 16 + 4) + pixels * 24 + std::uint64_t(bootstrap) * 4 + 256;
+  return std::uint64_t(shared::primarySampleSlots(chains)) * dims * 8ull + std::uint64_t(chains) * 20 + pixels * 24 +
+         std::uint64_t(bootstrap) * 4 + 256;
 }
 
 std::uint32_t MltIntegrator::iterationsPerPassFor(const RenderSettings& s) {
@@ -41,7 +42,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
     return &m_buffers.back();
   };
   m_mlt = make(sizeof(GpuMlt), "mlt state", true);
-  vk::Buffer* current = make(std::uint64_t(m_chains) * m_dims * 8, "mlt current vectors");
+  vk::Buffer* current = make(std::uint64_t(shared::primarySampleSlots(m_chains)) * m_dims * 8, "mlt current vectors");
   vk::Buffer* state = make(std::uint64_t(m_chains) * 16, "mlt chain states");
   m_splats = make(m_pixels * 24, "mlt splats");
   m_poolF = make(std::uint64_t(m_poolSize) * 4, "mlt bootstrap");

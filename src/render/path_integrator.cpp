@@ -39,7 +39,7 @@ std::uint64_t PathIntegrator::bytesFor(std::uint32_t capacity, std::size_t slots
   // Nine vec4 arrays of path and shadow-ray state, the queues (counters and item arrays), the
   // primary sample vectors.
   return std::uint64_t(capacity) * 9 * 16 + (QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + slots) * std::uint64_t(capacity)) * 4 +
-         std::uint64_t(capacity) * primaryDims * 8;
+         std::uint64_t(shared::primarySampleSlots(capacity)) * primaryDims * 8;
 }
 
 std::uint32_t PathIntegrator::primaryDimsFor(std::uint32_t maxDepth) {
@@ -83,7 +83,8 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   m_raysPerBounce.assign(STAT_BOUNCE_SLOTS, 0);
   g.stats = m_stats->address;
   // The primary sample vectors (none by default).
-  if (m_options.primaryDims) m_primarySamples = make(cap * m_options.primaryDims * 8, "primary samples");
+  if (m_options.primaryDims)
+    m_primarySamples = make(std::uint64_t(shared::primarySampleSlots(m_capacity)) * m_options.primaryDims * 8, "primary samples");
   g.primaryDims = m_options.primaryDims;
   g.primarySamples = m_primarySamples ? m_primarySamples->address : 0;
   g.maxDepth = m_settings.maxDepth;

@@ -20,9 +20,9 @@ class DeviceGuide;
 struct PathOptions {
   // 0: every number hashes (pixel, sample index, dimension, seed), the default. > 0: the stages
   // are specialised with PRIMARY_SAMPLES (constant 11) and path slot i of a chunk reads its first
-  // primaryDims 2-D draws from primarySamples() (draw d at d * capacity() + i: one plane per
-  // dimension, so neighbouring lanes read neighbouring memory): a path is then a function of that
-  // vector (primaryDimsFor covers every draw of a path).
+  // primaryDims 2-D draws from primarySamples() (draw d at shared::primarySampleIndex(i, d,
+  // primaryDims), layout.h): a path is then a function of that vector (primaryDimsFor covers
+  // every draw of a path).
   std::uint32_t primaryDims = 0;
   // With primaryDims: draw 0 places the camera ray anywhere on the image and the path's pixel
   // follows from it (camera constant 12, IMAGE_SAMPLES; Metropolis chains move across pixels).
@@ -73,7 +73,7 @@ class PathIntegrator : public Integrator {
   std::uint32_t capacity() const { return m_capacity; }
   // Per path slot: the radiance of its last traced path (rgb).
   const vk::Buffer& pathRadiance() const { return *m_pathRadiance; }
-  // PathOptions::primaryDims planes of capacity() vec2s (only when PathOptions::primaryDims > 0).
+  // primarySampleSlots(capacity()) x PathOptions::primaryDims vec2s (only when primaryDims > 0).
   vk::Buffer& primarySamples() { return *m_primarySamples; }
 
  private:

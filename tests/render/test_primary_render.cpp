@@ -10,6 +10,7 @@
 #include "../support/test_support.h"
 #include "cli/cli_common.h"
 #include "render/path_integrator.h"
+#include "../../shaders/shared/layout.h"
 
 using namespace nusselt;
 
@@ -30,12 +31,12 @@ TEST(PrimaryRender, SameVectorSamePathOtherVectorOtherPath) {
   ASSERT_GE(paths.capacity(), slots);
   // Even pixels: both samples read the same vector; odd pixels: two independent vectors.
   std::mt19937 prng(11);
-  // Draw d of slot i at d x capacity + i (one plane per dimension).
-  const std::uint32_t capacity = paths.capacity();
-  std::vector<glm::vec2> u(std::size_t(capacity) * dims);
+  // Draw d of slot i at primarySampleIndex(i, d, dims) (layout.h).
+  std::vector<glm::vec2> u(std::size_t(shared::primarySampleSlots(paths.capacity())) * dims);
   for (glm::vec2& x : u) x = glm::vec2(float(prng() >> 8), float(prng() >> 8)) * (1.0f / 16777216.0f);
   for (std::uint32_t p = 0; p < pixels; p += 2)
-    for (std::uint32_t d = 0; d < dims; ++d) u[std::size_t(d) * capacity + 2 * p + 1] = u[std::size_t(d) * capacity + 2 * p];
+    for (std::uint32_t d = 0; d < dims; ++d)
+      u[shared::primarySampleIndex(2 * p + 1, d, dims)] = u[shared::primarySampleIndex(2 * p, d, dims)];
   vk::uploadBuffer(test::context(), paths.primarySamples(), u.data(), u.size() * 8);
   r.renderPass(2);
   std::vector<glm::vec4> L(slots);
