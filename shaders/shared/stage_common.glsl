@@ -35,7 +35,7 @@
 // Every draw of a path goes through pathSample2 / pathSample1 (key, dimension), the dimensions of
 // rng.h. The default source hashes (pixel, sample index, dimension, seed) (or QMC: sample2). A
 // stage specialised with PRIMARY_SAMPLES (constant 11; no integrator sets it yet) reads the first
-// g.primaryDims dimensions of a path from its slot of g.primarySamples instead: the primary sample
+// g.primaryDims dimensions of a path from g.primarySamples instead (layout.h, primarySampleIndex): the primary sample
 // vector that a primary-sample-space Metropolis chain mutates (dimensions beyond them still hash).
 // The samplers' further numbers follow their primary numbers (rng.h, rngStreamKey), so a path is
 // a function of this vector. Off, the branch is compiled out and the images are those of the hash.
@@ -63,7 +63,7 @@ PathKey pathKey(uint path) {
 vec2 pathSample2(PathKey k, uint dimension) {
   if (PRIMARY_SAMPLES && dimension < g.primaryDims) {
     Vec2s p = g.primarySamples;
-    return p.v[k.path * g.primaryDims + dimension];
+    return p.v[primarySampleIndex(k.path, dimension, g.primaryDims)];
   }
   return sample2(k.rngMode, k.pixel, k.sampleIndex, dimension, k.seed);
 }
