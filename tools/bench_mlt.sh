@@ -27,21 +27,18 @@ scenes=${SCENES:-"default scenes/cornell/cornell-glass.glb"}
 mkdir -p "$dir"
 common="--width $size --height $size --max-depth $depth -q --checkpoint 0"
 
-median() { sort -g | awk '{v[NR] = $1} END {if (NR % 2) print v[(NR + 1) / 2]; else print (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
+# shellcheck source=tools/bench_lib.sh
+source tools/bench_lib.sh
 attr() { "$bin" info "$1" | sed -n "s/^  nusselt\/$2: //p" | head -1; }
 
 echo "bench_mlt: ${size}x${size}, --time $budget per run, reference $refSpp spp (path), max depth $depth, $repeats repeats, mlt with: ${MLT_ARGS:-(defaults)}"
 echo "device: $("$bin" devices | head -1)"
 for scene in $scenes; do
-  name=$(basename "${scene%.gltf}" .glb)
-  sceneArg=$scene
-  [ "$scene" = default ] && sceneArg=""
+  name=$(scene_name "$scene")
+  sceneArg=$(scene_arg "$scene")
   ref="$dir/$name-ref-$size-$refSpp-$depth.exr"
-  if [ ! -f "$ref" ]; then
-    echo "$name: rendering the reference ($refSpp spp)..."
-    # shellcheck disable=SC2086
-    "$bin" render $sceneArg $common --spp "$refSpp" --seed 1000 -o "$ref"
-  fi
+  # shellcheck disable=SC2086
+  bench_reference "$bin" "$scene" "$ref" "$refSpp" $common
   : > "$dir/$name.path"
   : > "$dir/$name.mlt"
   for ((r = 1; r <= repeats; r++)); do
