@@ -130,6 +130,38 @@ SHARED_FN bool bvhHitTriangle(vec3 origin, vec3 dir, GpuTriangle tri, float tmin
   return det != 0.0f && b1 >= 0.0f && b2 >= 0.0f && b1 + b2 <= 1.0f && t > tmin && t < tmax;
 }
 
+// The triangles [first, first + count) of a leaf: the nearest that passes, with t < the current
+// t, replaces the hit record.
+SHARED_FN void bvhLeafClosest(vec3 origin, vec3 dir, uint first, uint count, float tmin, INOUT(float) t,
+                              INOUT(float) b1, INOUT(float) b2, INOUT(uint) tri, INOUT(bool) found) {
+  BVH_LOCALS
+  for (uint i = first; i < first + count; ++i) {
+    float tt;
+    float u;
+    float v;
+    if (bvhHitTriangle(origin, dir, BVH_TRIANGLE(i), tmin, t, tt, u, v) && BVH_PASSES(i, u, v, origin, dir)) {
+      t = tt;
+      b1 = u;
+      b2 = v;
+      tri = i;
+      found = true;
+    }
+  }
+}
+
+// Whether a triangle of [first, first + count) is hit in (tmin, tmax) and passes.
+SHARED_FN bool bvhLeafAny(vec3 origin, vec3 dir, uint first, uint count, float tmin, float tmax) {
+  BVH_LOCALS
+  for (uint i = first; i < first + count; ++i) {
+    float tt;
+    float u;
+    float v;
+    if (bvhHitTriangle(origin, dir, BVH_TRIANGLE(i), tmin, tmax, tt, u, v) && BVH_PASSES(i, u, v, origin, dir))
+      return true;
+  }
+  return false;
+}
+
 // Closest hit with tmin < t < tmax: t, the barycentrics of v1 and v2, and the index of the
 // triangle in the reordered triangle array (the index of g.triangles and g.shading). On a miss
 // t = tmax and tri = INVALID_INDEX.
@@ -153,33 +185,11 @@ SHARED_FN bool traceClosest(vec3 origin, vec3 dir, float tmin, float tmax, OUT(f
     bool hit0 = bvhHitBox(ray, n.min0, n.max0, tmin, t, enter0);
     bool hit1 = bvhHitBox(ray, n.min1, n.max1, tmin, t, enter1);
     if (hit0 && n.link.z > 0u) {
-      for (uint i = n.link.x; i < n.link.x + n.link.z; ++i) {
-        float tt;
-        float u;
-        float v;
-        if (bvhHitTriangle(origin, dir, BVH_TRIANGLE(i), tmin, t, tt, u, v) && BVH_PASSES(i, u, v, origin, dir)) {
-          t = tt;
-          b1 = u;
-          b2 = v;
-          tri = i;
-          found = true;
-        }
-      }
+      bvhLeafClosest(origin, dir, n.link.x, n.link.z, tmin, t, b1, b2, tri, found);
       hit0 = false;
     }
     if (hit1 && n.link.w > 0u) {
-      for (uint i = n.link.y; i < n.link.y + n.link.w; ++i) {
-        float tt;
-        float u;
-        float v;
-        if (bvhHitTriangle(origin, dir, BVH_TRIANGLE(i), tmin, t, tt, u, v) && BVH_PASSES(i, u, v, origin, dir)) {
-          t = tt;
-          b1 = u;
-          b2 = v;
-          tri = i;
-          found = true;
-        }
-      }
+      bvhLeafClosest(origin, dir, n.link.y, n.link.w, tmin, t, b1, b2, tri, found);
       hit1 = false;
     }
     if (hit0 && hit1) {
@@ -219,23 +229,11 @@ SHARED_FN bool traceAny(vec3 origin, vec3 dir, float tmin, float tmax) {
     bool hit0 = bvhHitBox(ray, n.min0, n.max0, tmin, tmax, enter0);
     bool hit1 = bvhHitBox(ray, n.min1, n.max1, tmin, tmax, enter1);
     if (hit0 && n.link.z > 0u) {
-      for (uint i = n.link.x; i < n.link.x + n.link.z; ++i) {
-        float tt;
-        float u;
-        float v;
-        if (bvhHitTriangle(origin, dir, BVH_TRIANGLE(i), tmin, tmax, tt, u, v) && BVH_PASSES(i, u, v, origin, dir))
-          return true;
-      }
+      if (bvhLeafAny(origin, dir, n.link.x, n.link.z, tmin, tmax)) return true;
       hit0 = false;
     }
     if (hit1 && n.link.w > 0u) {
-      for (uint i = n.link.y; i < n.link.y + n.link.w; ++i) {
-        float tt;
-        float u;
-        float v;
-        if (bvhHitTriangle(origin, dir, BVH_TRIANGLE(i), tmin, tmax, tt, u, v) && BVH_PASSES(i, u, v, origin, dir))
-          return true;
-      }
+      if (bvhLeafAny(origin, dir, n.link.y, n.link.w, tmin, tmax)) return true;
       hit1 = false;
     }
     if (hit0 && hit1) {
