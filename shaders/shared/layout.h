@@ -331,19 +331,6 @@ struct BounceConstants {
 };
 STATIC_ASSERT_SIZE(BounceConstants, 16);
 
-// submit: turns queue counts into indirect dispatch arguments and empties consumed queues.
-struct SubmitConstants {
-  uint argsQueue;   // queue whose dispatch arguments to write, or INVALID_INDEX
-  uint argsFirst;   // first of a range of queues whose arguments to write
-  uint argsCount;
-  uint zeroFirst;   // first of a range of queues to empty
-  uint zeroCount;
-  uint bounce;      // the bounce whose ray queue argsQueue is (per-bounce ray counts)
-  uint reserved1;
-  uint reserved2;
-};
-STATIC_ASSERT_SIZE(SubmitConstants, 32);
-
 // display (the preview): tone mapping of the film into the display buffer.
 struct DisplayConstants {
   float exposureScale;  // 2^stops

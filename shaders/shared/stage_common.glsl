@@ -165,6 +165,9 @@ uint queueItem(uint queue, uint i) { return g.queues.v[QUEUE_HEADER_UINTS + queu
 // to its model's shade queue): the lanes pushing to the same queue as the first remaining lane
 // take one atomic together, then the others repeat (at most one round per distinct queue; one
 // atomic per subgroup and queue instead of one per lane, which halves the cost on lavapipe).
+// The same lane keeps the queue's indirect dispatch size current (ceil(count / WORKGROUP_SIZE)
+// workgroups, by atomicMax: counts only grow while a queue fills), so that no stage between
+// producer and consumer has to turn counts into dispatch sizes (PathIntegrator::recordPass).
 void queuePush(uint queue, uint path) {
   for (int round = 0; round < 128; ++round) {
     uint leader = subgroupBroadcastFirst(queue);
@@ -173,7 +176,13 @@ void queuePush(uint queue, uint path) {
       uint n = subgroupBallotBitCount(ballot);
       uint rank = subgroupBallotExclusiveBitCount(ballot);
       uint base = 0u;
-      if (subgroupElect()) base = atomicAdd(g.queues.v[queue], n);
+      if (subgroupElect()) {
+        base = atomicAdd(g.queues.v[queue], n);
+        Uints args = Uints(g.dispatchArgs);
+        atomicMax(args.v[4u * queue], (base + n + WORKGROUP_SIZE - 1u) / WORKGROUP_SIZE);
+        args.v[4u * queue + 1u] = 1u;
+        args.v[4u * queue + 2u] = 1u;
+      }
       base = subgroupBroadcastFirst(base);
       g.queues.v[QUEUE_HEADER_UINTS + queue * g.pathCapacity + base + rank] = path;
       return;

@@ -9,7 +9,13 @@ STAGE_PUSH(BounceConstants);
 void main() {
   uint queue = pc.bounce & 1u;
   uint idx = gl_GlobalInvocationID.x;
-  if (idx >= queueCount(queue)) return;
+  uint count = queueCount(queue);
+  if (idx >= count) return;
+  // Rays traced, in all and at this bounce (the queue is complete while it is consumed).
+  if (idx == 0u) {
+    atomicAdd(g.stats.v[STAT_RAYS], count);
+    atomicAdd(g.stats.v[STAT_PER_BOUNCE + min(pc.bounce, STAT_BOUNCE_SLOTS - 1u)], count);
+  }
   uint path = queueItem(queue, idx);
 
   vec3 o = g.pathOrigin.v[path].xyz;

@@ -6,7 +6,9 @@ STAGE_PUSH(BounceConstants);
 
 void main() {
   uint idx = gl_GlobalInvocationID.x;
-  if (idx >= queueCount(QUEUE_SHADOW)) return;
+  uint count = queueCount(QUEUE_SHADOW);
+  if (idx >= count) return;
+  if (idx == 0u) atomicAdd(g.stats.v[STAT_SHADOW_RAYS], count);
   uint path = queueItem(QUEUE_SHADOW, idx);
   vec4 o = g.shadowOrigin.v[path];
   vec3 d = g.shadowDirection.v[path].xyz;

@@ -15,7 +15,6 @@ namespace nusselt {
 using shared::DispatchArgs;
 using shared::Globals;
 using shared::BounceConstants;
-using shared::SubmitConstants;
 
 std::uint32_t PathIntegrator::capacityFor(const RenderSettings& settings, std::uint64_t pixels, std::uint32_t samples) {
   std::uint32_t maxChunk = std::min<std::uint32_t>(settings.maxPathsPerChunk, 65535u * WORKGROUP_SIZE);
@@ -108,7 +107,7 @@ PathIntegrator::~PathIntegrator() {
   if (m_fence) vkDestroyFence(d, m_fence, nullptr);
   if (m_queryPool) vkDestroyQueryPool(d, m_queryPool, nullptr);
   if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
-  for (auto* p : {&m_camera, &m_submit, &m_intersect, &m_escape, &m_shadow, &m_accumulate})
+  for (auto* p : {&m_camera, &m_intersect, &m_escape, &m_shadow, &m_accumulate})
     if (p->pipeline) vk::destroyComputePipeline(m_ctx, *p);
   for (auto& p : m_shade) vk::destroyComputePipeline(m_ctx, p);
   for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
@@ -131,7 +130,6 @@ void PathIntegrator::mark(VkCommandBuffer cmd, const char* stage) {
 void PathIntegrator::createPipelines() {
   const VkPipelineLayout layout = m_globals.layout();
   m_camera = vk::createComputePipeline(m_ctx, layout, "camera");
-  m_submit = vk::createComputePipeline(m_ctx, layout, "submit");
   // The tracing stages' module for the traversal (the Renderer resolved Auto): <stage>_rq with ray
   // queries, <stage> with the GLSL BVH (CMakeLists.txt). Only the used one is compiled.
   const std::string tracing = m_settings.traversal == Traversal::RayQuery ? "_rq" : "";
@@ -200,20 +198,10 @@ void PathIntegrator::createPipelines() {
     if (!e.empty()) throw Error(e);
 }
 
-void PathIntegrator::dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst,
-                                    std::uint32_t zeroCount, std::uint32_t argsFirst, std::uint32_t argsCount,
-                                    std::uint32_t bounce) {
-  SubmitConstants pc{};
-  pc.bounce = bounce;
-  pc.argsQueue = queueA;
-  pc.argsFirst = argsFirst;
-  pc.argsCount = argsCount;
-  pc.zeroFirst = zeroFirst;
-  pc.zeroCount = zeroCount;
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_submit.pipeline);
-  vkCmdPushConstants(cmd, m_globals.layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
-  vkCmdDispatch(cmd, 1, 1, 1);
-  vk::computeBarrier(cmd);
+void PathIntegrator::emptyQueues(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t count) {
+  if (count == 0) return;
+  vkCmdFillBuffer(cmd, m_queues->buffer, first * 4, count * 4, 0);
+  vkCmdFillBuffer(cmd, m_args->buffer, first * sizeof(DispatchArgs), count * sizeof(DispatchArgs), 0);
 }
 
 void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
@@ -224,8 +212,9 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
   m_marks.clear();
   if (m_queryPool) vkCmdResetQueryPool(cmd, m_queryPool, 0, m_queryCapacity);
   mark(cmd, nullptr);
-  // All queues start empty.
+  // All queues start empty (counts and dispatch sizes).
   vkCmdFillBuffer(cmd, m_queues->buffer, 0, QUEUE_HEADER_UINTS * 4, 0);
+  vkCmdFillBuffer(cmd, m_args->buffer, 0, VK_WHOLE_SIZE, 0);
   // Path guiding's training records start as "ended here" (guiding_layout.h).
   if (m_guide && m_guide->recording()) vkCmdFillBuffer(cmd, m_guide->records().buffer, 0, VK_WHOLE_SIZE, 0);
   vk::computeBarrier(cmd);
@@ -241,19 +230,30 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
   vk::computeBarrier(cmd);
   mark(cmd, "camera");
 
+  // Queue sizes need no stage of their own: the pushes keep each queue's indirect dispatch size
+  // current (queuePush, stage_common.glsl), and the consumers tally the rays they trace. Before
+  // intersect(b) the queues that bounce b - 1 consumed are emptied in one place: its ray queue,
+  // the shadow queue, the escape and shade queues; ray queue b & 1 holds bounce b's rays.
   for (std::uint32_t bounce = 0; bounce <= m_settings.maxDepth; ++bounce) {
     const std::uint32_t rayQueue = bounce & 1u;
     pc.bounce = bounce;
-    // intersect <- ray queue; empties the shadow queue of the previous bounce.
-    dispatchSubmit(cmd, rayQueue, QUEUE_SHADOW, 1, 0, 0, bounce);
-    mark(cmd, "submit");
+    if (bounce > 0) {
+      static_assert(QUEUE_RAY0 == 0 && QUEUE_RAY1 == 1 && QUEUE_SHADOW == 2 && QUEUE_ESCAPE == 3 && QUEUE_SHADE_BASE == 4);
+      const std::uint32_t consumed = rayQueue ^ 1u;
+      if (consumed == QUEUE_RAY1) {
+        emptyQueues(cmd, QUEUE_RAY1, QUEUE_SHADE_BASE + slots - QUEUE_RAY1);
+      } else {
+        emptyQueues(cmd, QUEUE_RAY0, 1);
+        emptyQueues(cmd, QUEUE_SHADOW, QUEUE_SHADE_BASE + slots - QUEUE_SHADOW);
+      }
+      vk::computeBarrier(cmd);
+    }
+    // intersect <- ray queue.
     bindAndPush(m_intersect);
     vkCmdDispatchIndirect(cmd, m_args->buffer, rayQueue * sizeof(DispatchArgs));
     vk::computeBarrier(cmd);
     mark(cmd, "intersect");
-    // escape, shade(model) <- escape and shade queues; empties the consumed ray queue.
-    dispatchSubmit(cmd, INVALID_INDEX, rayQueue, 1, QUEUE_ESCAPE, slots + 1);
-    mark(cmd, "submit");
+    // escape, shade(model) <- escape and shade queues.
     if (m_hasEscape) {
       bindAndPush(m_escape);
       vkCmdDispatchIndirect(cmd, m_args->buffer, QUEUE_ESCAPE * sizeof(DispatchArgs));
@@ -270,9 +270,7 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
       }
     }
     vk::computeBarrier(cmd);
-    // shadow <- shadow queue; empties the escape and shade queues.
-    dispatchSubmit(cmd, QUEUE_SHADOW, QUEUE_ESCAPE, slots + 1, 0, 0);
-    mark(cmd, "submit");
+    // shadow <- shadow queue.
     bindAndPush(m_shadow);
     vkCmdDispatchIndirect(cmd, m_args->buffer, QUEUE_SHADOW * sizeof(DispatchArgs));
     vk::computeBarrier(cmd);
