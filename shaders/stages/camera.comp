@@ -39,5 +39,6 @@ void main() {
   if (i == 0u) {
     g.queues.v[QUEUE_RAY0] = g.chunkPaths;
     g.dispatchArgs.v[QUEUE_RAY0] = uvec4((g.chunkPaths + WORKGROUP_SIZE - 1u) / WORKGROUP_SIZE, 1u, 1u, 0u);
+    g.dispatchArgs.v[ARGS_TRACE0] = g.dispatchArgs.v[QUEUE_RAY0];
   }
 }

@@ -67,7 +67,7 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   std::uint64_t queueUints = QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + m_slotKeys.size()) * cap;
   m_queues = make(queueUints * 4, "queue");
   g.queues = m_queues->address;
-  m_args = make(QUEUE_COUNT * sizeof(DispatchArgs), "dispatch arguments", VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+  m_args = make(ARGS_COUNT * sizeof(DispatchArgs), "dispatch arguments", VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
   g.dispatchArgs = m_args->address;
   m_stats = make(STAT_BUFFER_UINTS * 4, "statistics", 0, true);
   std::memset(m_stats->mapped, 0, STAT_BUFFER_UINTS * 4);
@@ -107,7 +107,7 @@ PathIntegrator::~PathIntegrator() {
   if (m_fence) vkDestroyFence(d, m_fence, nullptr);
   if (m_queryPool) vkDestroyQueryPool(d, m_queryPool, nullptr);
   if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
-  for (auto* p : {&m_camera, &m_intersect, &m_escape, &m_shadow, &m_accumulate})
+  for (auto* p : {&m_camera, &m_intersect, &m_escape, &m_accumulate})
     if (p->pipeline) vk::destroyComputePipeline(m_ctx, *p);
   for (auto& p : m_shade) vk::destroyComputePipeline(m_ctx, p);
   for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
@@ -148,7 +148,6 @@ void PathIntegrator::createPipelines() {
                                            {0, 0, 0, 0, 0, 0, 0, 1u, m_hasTextures ? 1u : 0u, 0u, guiding});
     else m_escape = vk::createComputePipeline(m_ctx, layout, "escape");
   }
-  m_shadow = vk::createComputePipeline(m_ctx, layout, "shadow" + tracing + alpha, traceSpec);
   m_accumulate = vk::createComputePipeline(m_ctx, layout, "accumulate");
   // Only the models (and combinations) this scene uses: one specialised shade pipeline each,
   // created on all cores (drivers compile at creation; lavapipe takes ~0.3 s per shade pipeline,
@@ -204,6 +203,10 @@ void PathIntegrator::emptyQueues(VkCommandBuffer cmd, std::uint32_t first, std::
   vkCmdFillBuffer(cmd, m_args->buffer, first * sizeof(DispatchArgs), count * sizeof(DispatchArgs), 0);
 }
 
+void PathIntegrator::emptyTraceArgs(VkCommandBuffer cmd, std::uint32_t parity) {
+  vkCmdFillBuffer(cmd, m_args->buffer, (ARGS_TRACE0 + parity) * sizeof(DispatchArgs), sizeof(DispatchArgs), 0);
+}
+
 void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
   const std::uint32_t slots = static_cast<std::uint32_t>(m_slotKeys.size());
   const VkPipelineLayout layout = m_globals.layout();
@@ -231,28 +234,42 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
   mark(cmd, "camera");
 
   // Queue sizes need no stage of their own: the pushes keep each queue's indirect dispatch size
-  // current (queuePush, stage_common.glsl), and the consumers tally the rays they trace. Before
-  // intersect(b) the queues that bounce b - 1 consumed are emptied in one place: its ray queue,
-  // the shadow queue, the escape and shade queues; ray queue b & 1 holds bounce b's rays.
+  // current (queuePush, stage_common.glsl), and the consumers tally the rays they trace. A bounce
+  // b is two dispatches: the trace stage (intersect.comp: ray queue b & 1 and the shadow rays of
+  // bounce b - 1, shadow queue (b - 1) & 1) and shade. Before trace(b) the queues that bounce b - 1
+  // consumed are emptied in one place: ray queue (b - 1) & 1, shadow queue b & 1, the escape and
+  // shade queues, and trace(b - 1)'s dispatch size (shade(b) sizes trace(b + 1) there).
   for (std::uint32_t bounce = 0; bounce <= m_settings.maxDepth; ++bounce) {
     const std::uint32_t rayQueue = bounce & 1u;
     pc.bounce = bounce;
     if (bounce > 0) {
-      static_assert(QUEUE_RAY0 == 0 && QUEUE_RAY1 == 1 && QUEUE_SHADOW == 2 && QUEUE_ESCAPE == 3 && QUEUE_SHADE_BASE == 4);
-      const std::uint32_t consumed = rayQueue ^ 1u;
-      if (consumed == QUEUE_RAY1) {
-        emptyQueues(cmd, QUEUE_RAY1, QUEUE_SHADE_BASE + slots - QUEUE_RAY1);
-      } else {
-        emptyQueues(cmd, QUEUE_RAY0, 1);
-        emptyQueues(cmd, QUEUE_SHADOW, QUEUE_SHADE_BASE + slots - QUEUE_SHADOW);
-      }
+      static_assert(QUEUE_RAY0 == 0 && QUEUE_RAY1 == 1 && QUEUE_SHADOW0 == 2 && QUEUE_SHADOW1 == 3 &&
+                    QUEUE_ESCAPE == 4 && QUEUE_SHADE_BASE == 5);
+      const std::uint32_t consumedRays = rayQueue ^ 1u;
+      const std::uint32_t consumedShadows = QUEUE_SHADOW0 + rayQueue;
+      emptyQueues(cmd, consumedRays, 1);
+      emptyQueues(cmd, consumedShadows, 1);
+      emptyQueues(cmd, QUEUE_ESCAPE, QUEUE_SHADE_BASE + slots - QUEUE_ESCAPE);
+      emptyTraceArgs(cmd, rayQueue ^ 1u);
       vk::computeBarrier(cmd);
     }
-    // intersect <- ray queue.
-    bindAndPush(m_intersect);
-    vkCmdDispatchIndirect(cmd, m_args->buffer, rayQueue * sizeof(DispatchArgs));
-    vk::computeBarrier(cmd);
-    mark(cmd, "intersect");
+    if (m_queryPool) {  // timed runs only: rays and shadow rays on their own, to time them apart
+      pc.traceMode = TRACE_RAYS;
+      bindAndPush(m_intersect);
+      vkCmdDispatchIndirect(cmd, m_args->buffer, rayQueue * sizeof(DispatchArgs));
+      vk::computeBarrier(cmd);
+      mark(cmd, "intersect");
+      pc.traceMode = TRACE_SHADOWS;
+      bindAndPush(m_intersect);
+      vkCmdDispatchIndirect(cmd, m_args->buffer, (QUEUE_SHADOW0 + (rayQueue ^ 1u)) * sizeof(DispatchArgs));
+      vk::computeBarrier(cmd);
+      mark(cmd, "shadow");
+      pc.traceMode = TRACE_BOTH;
+    } else {
+      bindAndPush(m_intersect);
+      vkCmdDispatchIndirect(cmd, m_args->buffer, (ARGS_TRACE0 + rayQueue) * sizeof(DispatchArgs));
+      vk::computeBarrier(cmd);
+    }
     // escape, shade(model) <- escape and shade queues.
     if (m_hasEscape) {
       bindAndPush(m_escape);
@@ -270,11 +287,7 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
       }
     }
     vk::computeBarrier(cmd);
-    // shadow <- shadow queue.
-    bindAndPush(m_shadow);
-    vkCmdDispatchIndirect(cmd, m_args->buffer, QUEUE_SHADOW * sizeof(DispatchArgs));
-    vk::computeBarrier(cmd);
-    mark(cmd, "shadow");
+    // (shade(maxDepth) queues no shadow rays: the last bounce takes no light sample.)
   }
   bindAndPush(m_accumulate);
   vkCmdDispatch(cmd, groups, 1, 1);
