@@ -24,22 +24,19 @@ repeats=${REPEATS:-3}
 depth=${DEPTH:-8}
 scenes=${SCENES:-"scenes/cornell/cornell-indirect.glb scenes/tests/guiding_gap.gltf default"}
 mkdir -p "$dir"
+# shellcheck source=tools/bench_lib.sh
+source tools/bench_lib.sh
 common="--width $size --height $size --max-depth $depth -q --checkpoint 0"
 
-median() { sort -g | awk '{v[NR] = $1} END {if (NR % 2) print v[(NR + 1) / 2]; else print (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
 
 echo "bench_guiding: ${size}x${size}, $spp spp per run, reference $refSpp spp (unguided), max depth $depth, $repeats repeats, guided with: --guiding on ${GUIDE_ARGS:-}"
 echo "device: $("$bin" devices | head -1)"
 for scene in $scenes; do
-  name=$(basename "${scene%.gltf}" .glb)
-  sceneArg=$scene
-  [ "$scene" = default ] && sceneArg=""
+  name=$(scene_name "$scene")
+  sceneArg=$(scene_arg "$scene")
   ref="$dir/$name-ref-$size-$refSpp-$depth.exr"
-  if [ ! -f "$ref" ]; then
-    echo "$name: rendering the reference ($refSpp spp)..."
-    # shellcheck disable=SC2086
-    "$bin" render $sceneArg $common --spp "$refSpp" --seed 1000 -o "$ref"
-  fi
+  # shellcheck disable=SC2086
+  bench_reference "$bin" "$scene" "$ref" "$refSpp" $common
   : > "$dir/$name.off"
   : > "$dir/$name.on"
   for ((r = 1; r <= repeats; r++)); do

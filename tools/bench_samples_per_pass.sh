@@ -9,7 +9,8 @@ repeats=${1:-5}
 bin=${2:-$(dirname "$0")/../build/nusselt}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
+# shellcheck source=tools/bench_lib.sh
+source "$(dirname "$0")/bench_lib.sh"
 echo "# $("$bin" devices 2>/dev/null | head -1); load average $(cut -d' ' -f1-3 /proc/loadavg); $repeats repeats, interleaved"
 printf "%-9s %5s %-14s %-14s %8s %s\n" size spp "1 per pass (s)" "auto (s)" speed-up "images"
 for case in "64 256" "256 64"; do

@@ -6,6 +6,9 @@
 # libclang-rt-14-dev (tools/bootstrap.sh).
 # Usage: tools/fuzz.sh [SECONDS] [fuzzer...]      fuzzers: fuzz_gltf fuzz_brdf_params fuzz_image fuzz_hdr fuzz_merl
 # Extra libFuzzer flags: FUZZ_FLAGS="-jobs=2 -workers=2" tools/fuzz.sh 1800 fuzz_gltf
+# FUZZ_SEED (default 1) fixes libFuzzer's mutation sequence, so a CI run explores the same inputs
+# each time (up to where its time runs out) and a finding reproduces; FUZZ_SEED=0 lets libFuzzer
+# pick a new seed per run, for exploratory runs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
@@ -36,7 +39,7 @@ for f in "${fuzzers[@]}"; do
   set +e
   # -timeout: one input may take at most 10 s; -rss_limit_mb: the loader's own caps keep a
   # hostile file well below this; -max_len: large enough for the cornell-box seed and mutations.
-  $build/tests/fuzz/$f -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2560 -max_len=65536 \
+  $build/tests/fuzz/$f -seed="${FUZZ_SEED:-1}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2560 -max_len=65536 \
     -dict=tests/fuzz/${dict[$f]} -artifact_prefix=$build/findings/$f- -print_final_stats=1 \
     ${FUZZ_FLAGS:-} "$work" >"$log" 2>&1
   rc=$?

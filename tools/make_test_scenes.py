@@ -27,6 +27,9 @@
                  emitter of radiance 1 at z = 0 facing +z; camera above, looking down. Seen
                  through the slab at normal incidence the emitter converges to (1 - R) / (1 + R)
                  with R = 0.04 (both faces and every internal reflection).
+  glass_slab_tinted.gltf  glass_slab.gltf's slab with KHR_materials_volume attenuationColor
+                 (0.8, 0.5, 0.2) at attenuationDistance 0.2 (= its thickness): at normal incidence
+                 the emitter converges to (1 - R)^2 c / (1 - R^2 c^2) per channel.
   guiding_gap.gltf  two rooms (4 x 2 x 2, Lambert rho 0.7) divided by a wall at x = 0 with a
                  0.3 x 0.3 opening at its centre; the area light is on the ceiling of the left room,
                  the camera in the right one: the right room sees light only through the opening
@@ -434,6 +437,27 @@ def glass_slab():
     b.write("glass_slab.gltf")
 
 
+def glass_slab_tinted():
+    b = Builder()
+    b.use("KHR_materials_transmission")
+    b.use("KHR_materials_ior")
+    b.use("KHR_materials_volume")
+    # attenuationDistance = the slab's thickness: at normal incidence one crossing transmits
+    # attenuationColor.
+    glass = b.pbr_material("tinted", {"metallicFactor": 0.0, "roughnessFactor": 0.0},
+                           extensions={"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                                       "KHR_materials_ior": {"ior": 1.5},
+                                       "KHR_materials_volume": {"thicknessFactor": 0.2,
+                                                                "attenuationDistance": 0.2,
+                                                                "attenuationColor": [0.8, 0.5, 0.2]}})
+    lamp = b.material("lamp", 0.0, emission=(1.0, 1.0, 1.0))
+    b.quad("lamp", [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], lamp)
+    b.quad("top", [[-1, -1, 0.4], [1, -1, 0.4], [1, 1, 0.4], [-1, 1, 0.4]], glass)
+    b.quad("bottom", [[-1, -1, 0.2], [-1, 1, 0.2], [1, 1, 0.2], [1, -1, 0.2]], glass)
+    b.camera("camera", (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), 0.3, 1.0)
+    b.write("glass_slab_tinted.gltf")
+
+
 def guiding_gap():
     b = Builder()
     white = b.material("white", 0.7)
@@ -464,4 +488,5 @@ if __name__ == "__main__":
     env_bench(True)
     textures()
     glass_slab()
+    glass_slab_tinted()
     guiding_gap()

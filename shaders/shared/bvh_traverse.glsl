@@ -1,8 +1,8 @@
 // bvh_traverse.glsl: ray/scene intersection against the BVH of src/scene/bvh.cpp (GLSL only;
 // included after shared/layout.h). The node encoding is documented in src/scene/bvh.h.
-// bvhClosestHit in bvh.cpp is the C++ twin of traceClosest: change both together. (The alpha test
-// of MASK/BLEND materials, HAS_ALPHA and alphaPasses of stage_common.glsl, is GPU-only: the twin
-// answers for opaque scenes.)
+// bvhClosestHit in bvh.cpp is the C++ twin of traceClosest: change both together. The alpha test
+// of MASK/BLEND materials (HAS_ALPHA, alphaPasses of stage_common.glsl) is the twin's hit filter,
+// AlphaTester (src/render/texture_table.h); both apply shared/alpha.h.
 //
 // Shape of the loop (lavapipe truncates loops after 65,535 iterations per invocation, so keep
 // the iteration count low and the loops simple): one iteration per inner node visited. Each

@@ -84,6 +84,7 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 #define MATERIAL_COMBINED 4u  // a weighted sum of elementary BRDFs (GpuMaterial.components)
 #define MATERIAL_TEXTURED 8u  // a texture applies (Globals.materialTextures: GpuMaterialTextures)
 #define MATERIAL_ALPHA 16u    // alphaMode MASK or BLEND: hits are tested in traversal (trace.glsl)
+#define MATERIAL_ABSORBING 32u  // a refracting volume that absorbs (GpuMaterial.absorption; volume.h)
 
 // ---- Combined materials ---------------------------------------------------------------------------
 // At most this many components per material: the shade stage is specialised per tuple of component
@@ -156,13 +157,16 @@ STATIC_ASSERT_SIZE(BrdfParams, 128);
 // emission = emitted radiance (rgb), w unused.
 // components = (first GpuComponent, count, 0, 0) when MATERIAL_COMBINED (then info.x is the first
 // component's model and params/info.z are unused); (0, 0, 0, 0) otherwise.
+// absorption = the volume's absorption coefficient sigma_a [1/m] (rgb; volume.h), w unused; read
+// only when MATERIAL_ABSORBING.
 struct GpuMaterial {
   uvec4 info;
   vec4 emission;
   BrdfParams params;
   uvec4 components;
+  vec4 absorption;
 };
-STATIC_ASSERT_SIZE(GpuMaterial, 176);
+STATIC_ASSERT_SIZE(GpuMaterial, 192);
 
 // One term w * f_k of a combined material (shaders/shared/combined.h).
 // info = (model id, quadtree set index or INVALID_INDEX, 0, 0); data = (weight w, 0, 0, 0);
@@ -244,6 +248,31 @@ STATIC_ASSERT_SIZE(GpuEnvironment, 64);
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Environments { GpuEnvironment v[]; };
 #endif
 
+// A Metropolis render's chains (shaders/shared/mlt.h, src/render/mlt_integrator.cpp).
+// info = (chains, dims = primary draws per path, iteration of this step, pixels);
+// pool = (first pool path of this bootstrap chunk, paths in it, pool size, 0);
+// params = (large-step probability, small-step sigma, resolve scale (b x pixels / chains /
+// MLT_FIXED_SCALE), iterations in this pass (the film's sample count)).
+// current: the chains' current vectors (primarySampleIndex(c, d, dims)); state: per chain (its current
+// radiance L (rgb), its pixel as float bits); splats: per pixel 6 uints (r, g, b: low, high);
+// poolF: f of every bootstrap path; start: the pool path each chain starts from; counters:
+// MLT_COUNTERS uints, per pass.
+struct GpuMlt {
+  uvec4 info;
+  uvec4 pool;
+  vec4 params;
+  BUFREF(Vec2s) current;
+  BUFREF(Vec4s) state;
+  BUFREF(Uints) splats;
+  BUFREF(Floats) poolF;
+  BUFREF(Uints) start;
+  BUFREF(Uints) counters;
+};
+STATIC_ASSERT_SIZE(GpuMlt, 96);
+#ifndef __cplusplus
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Mlts { GpuMlt v[]; };
+#endif
+
 // Per-render constants and the addresses of every buffer (buffer device addresses: no storage
 // buffer binding limits the size of a scene; lavapipe caps one binding at 128 MiB).
 struct Globals {
@@ -319,12 +348,13 @@ struct Globals {
                                // sign), parallel to `triangles`; one entry when no material is normal-mapped
   BUFREF(GpuGuides) guide;     // one GpuGuide (guiding_layout.h; 0 unless the render is guided)
   BUFREF(Vec2s) primarySamples; // per path primaryDims 2-D draws (PRIMARY_SAMPLES stages only; 0 otherwise)
+  BUFREF(Mlts) mlt;            // one GpuMlt of a Metropolis render; 0 otherwise
   // The top-level acceleration structure's device address, low and high 32 bits, for ray queries
   // (shaders/shared/trace.glsl with NUSSELT_RAY_QUERY); 0 when the GLSL BVH traces.
   uint tlasLow;
   uint tlasHigh;
 };
-STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 38 * 8 + 8);
+STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 39 * 8 + 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 
@@ -384,6 +414,18 @@ STATIC_ASSERT_SIZE(TraceToolConstants, 16);
 layout(set = 0, binding = 0, std430) readonly buffer GlobalsBlock { Globals g; };
 #define STAGE_PUSH(T) layout(push_constant, std430) uniform PushBlock { T pc; }
 #endif
+
+// Where draw `dimension` of path slot `path` lives in Globals.primarySamples (and a Metropolis
+// chain's current vector, GpuMlt.current) of `dims` draws per path: blocks of 8 paths (a
+// subgroup on lavapipe), each block's draws one after the other, the 8 paths' values of a draw
+// side by side. Neighbouring lanes read neighbouring memory and one lane's draws stay within a
+// few KiB (one plane per dimension thrashed the TLB: 2-3x slower mutations on lavapipe).
+// A buffer holds primarySampleSlots(capacity) x dims vec2.
+#define PRIMARY_BLOCK 8u
+SHARED_FN uint primarySampleIndex(uint path, uint dimension, uint dims) {
+  return ((path / PRIMARY_BLOCK) * dims + dimension) * PRIMARY_BLOCK + path % PRIMARY_BLOCK;
+}
+SHARED_FN uint primarySampleSlots(uint capacity) { return (capacity + PRIMARY_BLOCK - 1u) / PRIMARY_BLOCK * PRIMARY_BLOCK; }
 
 SHARED_FN float brdfParam(BrdfParams p, uint i) { return p.v[i / 4u][i % 4u]; }
 SHARED_FN vec3 brdfParam3(BrdfParams p, uint i) {

@@ -28,12 +28,14 @@
 #include "shared/rng.h"
 #include "shared/warp.h"
 #include "shared/texture.h"
+#include "shared/volume.h"
+#include "shared/alpha.h"
 
 // ---- The path's random numbers: the primary sample source (issue 19) ----------------------------
 // Every draw of a path goes through pathSample2 / pathSample1 (key, dimension), the dimensions of
 // rng.h. The default source hashes (pixel, sample index, dimension, seed) (or QMC: sample2). A
 // stage specialised with PRIMARY_SAMPLES (constant 11; no integrator sets it yet) reads the first
-// g.primaryDims dimensions of a path from its slot of g.primarySamples instead: the primary sample
+// g.primaryDims dimensions of a path from g.primarySamples instead (layout.h, primarySampleIndex): the primary sample
 // vector that a primary-sample-space Metropolis chain mutates (dimensions beyond them still hash).
 // The samplers' further numbers follow their primary numbers (rng.h, rngStreamKey), so a path is
 // a function of this vector. Off, the branch is compiled out and the images are those of the hash.
@@ -61,7 +63,7 @@ PathKey pathKey(uint path) {
 vec2 pathSample2(PathKey k, uint dimension) {
   if (PRIMARY_SAMPLES && dimension < g.primaryDims) {
     Vec2s p = g.primarySamples;
-    return p.v[k.path * g.primaryDims + dimension];
+    return p.v[primarySampleIndex(k.path, dimension, g.primaryDims)];
   }
   return sample2(k.rngMode, k.pixel, k.sampleIndex, dimension, k.seed);
 }
@@ -85,19 +87,8 @@ Uints texelBuffer() {
 }
 
 #if NUSSELT_ALPHA
-// One step of a PCG-style integer hash (O'Neill's RXS-M-XS output on an LCG step), mixing in v.
-uint alphaHashStep(uint h, uint v) {
-  h = (h ^ v) * 747796405u + 2891336453u;
-  h = ((h >> ((h >> 28u) + 4u)) ^ h) * 277803737u;
-  return (h >> 22u) ^ h;
-}
-
-// Whether a candidate hit of triangle tri at barycentrics (b1, b2) of the ray (origin, dir)
-// counts. OPAQUE: always. MASK: alpha >= alphaCutoff. BLEND: with probability alpha (stochastic
-// transparency), decided by a hash of the ray and the triangle, so a render is a function of its
-// seed. alpha = baseColorFactor.a x the base-colour texture's alpha at the hit.
 // alpha = baseColorFactor.a x the base-colour texture's alpha of a MASK or BLEND material at
-// barycentrics (b1, b2) of triangle tri.
+// barycentrics (b1, b2) of triangle tri. (C++ twin: AlphaTester in src/render/texture_table.cpp.)
 float alphaAt(uint material, uint tri, float b1, float b2) {
   GpuMaterialTextures T = g.materialTextures.v[material];
   float alpha = T.baseColorFactor.w;
@@ -116,19 +107,13 @@ float alphaCoverage(uint material, uint tri, float b1, float b2) {
   return clamp(alpha, 0.0f, 1.0f);
 }
 
+// Whether a candidate hit of triangle tri at barycentrics (b1, b2) of the ray (origin, dir)
+// counts: the rule of shared/alpha.h (alphaTest) with the material's mode, alpha and cutoff.
 bool alphaPasses(uint tri, float b1, float b2, vec3 origin, vec3 dir) {
   uint material = g.shading.v[tri].info.x;
   if ((g.materials.v[material].info.y & MATERIAL_ALPHA) == 0u) return true;
   GpuMaterialTextures T = g.materialTextures.v[material];
-  float alpha = alphaAt(material, tri, b1, b2);
-  if (T.alpha.x == ALPHA_MASK) return alpha >= T.factors.w;
-  uint h = alphaHashStep(tri * 0x9e3779b9u, floatBitsToUint(origin.x));
-  h = alphaHashStep(h, floatBitsToUint(origin.y));
-  h = alphaHashStep(h, floatBitsToUint(origin.z));
-  h = alphaHashStep(h, floatBitsToUint(dir.x));
-  h = alphaHashStep(h, floatBitsToUint(dir.y));
-  h = alphaHashStep(h, floatBitsToUint(dir.z));
-  return float(h >> 8u) * (1.0f / 16777216.0f) < alpha;
+  return alphaTest(T.alpha.x, alphaAt(material, tri, b1, b2), T.factors.w, tri, origin, dir);
 }
 #else
 bool alphaPasses(uint tri, float b1, float b2, vec3 origin, vec3 dir) { return true; }

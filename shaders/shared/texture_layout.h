@@ -39,14 +39,18 @@ STATIC_ASSERT_SIZE(GpuTexture, 48);
 // map needs Globals.tangents);
 // baseColorFactor = rgba; factors = (metallicFactor, roughnessFactor, normalScale, alphaCutoff);
 // alpha = (ALPHA_* mode, the GpuTexture whose alpha multiplies baseColorFactor.a (the base-colour
-// texture, for any model) or INVALID_INDEX, 0, 0).
+// texture, for any model) or INVALID_INDEX, 0, 0);
+// transmission = (the GpuTexture of KHR_materials_transmission's texture or INVALID_INDEX, 0, 0, 0):
+// its R scales the weight of component 1 (the glass) of the transmission combination, and
+// component 0 (gltf_pbr) takes the rest (Material::transmissionTextured).
 struct GpuMaterialTextures {
   uvec4 maps;
   vec4 baseColorFactor;
   vec4 factors;
   uvec4 alpha;
+  uvec4 transmission;
 };
-STATIC_ASSERT_SIZE(GpuMaterialTextures, 64);
+STATIC_ASSERT_SIZE(GpuMaterialTextures, 80);
 
 // glTF alphaMode (the values of scene.h's AlphaMode).
 #define ALPHA_OPAQUE 0u

@@ -5,6 +5,10 @@
 // (sample index sampleIndex + k) of pixel (chunkFirst + i) / passSamples.
 #include "shared/stage_common.glsl"
 
+// Metropolis (issue 19, docs/mlt.md; constant 12, with PRIMARY_SAMPLES): draw 0 places the ray
+// anywhere on the image and the path's pixel follows from it, so a chain moves across pixels.
+layout(constant_id = 12) const bool IMAGE_SAMPLES = false;
+
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= g.chunkPaths) return;
@@ -17,6 +21,13 @@ void main() {
 
   // Pixel jitter: dimensions 0 and 1 (box filter over the pixel).
   vec2 u = pathSample2(PathKey(g.rngMode, pixel, sampleIndex, g.seed, i), 0u);
+  if (IMAGE_SAMPLES) {
+    vec2 xy = u * vec2(float(width), float(g.height));
+    px = min(uint(xy.x), width - 1u);
+    py = min(uint(xy.y), g.height - 1u);
+    u = clamp(xy - vec2(float(px), float(py)), 0.0f, 1.0f);
+    pixel = py * width + px;
+  }
   float sx = ((float(px) + u.x) / float(width)) * 2.0f - 1.0f;
   float sy = 1.0f - ((float(py) + u.y) / float(g.height)) * 2.0f;
 

@@ -116,11 +116,18 @@ vec3 normalMapped(uint material, uint tri, float b1, float b2, vec3 ns, vec3 ngF
   n /= nl;
   return dot(n, ngFront) * dot(ns, ngFront) > 0.0f ? n : ns;
 }
+
+// ---- transmissionTexture: its R at the hit, or -1 when the material has none ----
+float transmissionAt(uint material, uint tri, float b1, float b2) {
+  uint tex = g.materialTextures.v[material].transmission.x;
+  return tex == INVALID_INDEX ? -1.0f : sceneTexture(tex, tri, b1, b2).x;
+}
 #else
 // A module without textures (NUSSELT_SCENE_FEATURES 0, stage_common.glsl): empty stand-ins.
 void evalParams(uint model, uint material, uint tri, float b1, float b2, inout BrdfParams params,
                 inout vec3 emission) {}
 vec3 normalMapped(uint material, uint tri, float b1, float b2, vec3 ns, vec3 ngFront) { return ns; }
+float transmissionAt(uint material, uint tri, float b1, float b2) { return -1.0f; }
 #endif
 
 
@@ -150,7 +157,7 @@ struct ShadeMaterial {
   GuideVertex gv;  // the guide's region (path guiding): never for delta models
 };
 
-ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette) {
+ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, float transmissionR) {
   ShadeMaterial m;
   m.M = M;
   m.gv = GuideVertex(0u, 0.0f);
@@ -225,15 +232,27 @@ struct ShadeMaterial {
   bool lightSamples; // no delta flag on the material
 };
 
-ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette) {
+// transmissionR: the transmission texture's R at the hit (transmissionAt), or -1.
+ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, float transmissionR) {
   ShadeMaterial m;
   m.a = vec4(0.0f);
   uint first = M.components.x;
   m.mode = combinedChoiceMode(g.componentChoice, roulette);
-  if (COMPONENT_COUNT > 0u) { m.C0 = g.components.v[first]; m.a.x = componentChoiceWeight(m.mode, SAMPLER, MODEL_0, m.C0, wo); }
-  if (COMPONENT_COUNT > 1u) { m.C1 = g.components.v[first + 1u]; m.a.y = componentChoiceWeight(m.mode, SAMPLER, MODEL_1, m.C1, wo); }
-  if (COMPONENT_COUNT > 2u) { m.C2 = g.components.v[first + 2u]; m.a.z = componentChoiceWeight(m.mode, SAMPLER, MODEL_2, m.C2, wo); }
-  if (COMPONENT_COUNT > 3u) { m.C3 = g.components.v[first + 3u]; m.a.w = componentChoiceWeight(m.mode, SAMPLER, MODEL_3, m.C3, wo); }
+  if (COMPONENT_COUNT > 0u) m.C0 = g.components.v[first];
+  if (COMPONENT_COUNT > 1u) m.C1 = g.components.v[first + 1u];
+  if (COMPONENT_COUNT > 2u) m.C2 = g.components.v[first + 2u];
+  if (COMPONENT_COUNT > 3u) m.C3 = g.components.v[first + 3u];
+  // The transmission combination {gltf_pbr, 1 - w; glass, w} under a transmission texture: the
+  // glass takes w R at this hit, gltf_pbr the rest (Material::transmissionTextured).
+  if (COMPONENT_COUNT == 2u && transmissionR >= 0.0f) {
+    float wt = m.C1.data.x * transmissionR;
+    m.C1.data.x = wt;
+    m.C0.data.x = 1.0f - wt;
+  }
+  if (COMPONENT_COUNT > 0u) m.a.x = componentChoiceWeight(m.mode, SAMPLER, MODEL_0, m.C0, wo);
+  if (COMPONENT_COUNT > 1u) m.a.y = componentChoiceWeight(m.mode, SAMPLER, MODEL_1, m.C1, wo);
+  if (COMPONENT_COUNT > 2u) m.a.z = componentChoiceWeight(m.mode, SAMPLER, MODEL_2, m.C2, wo);
+  if (COMPONENT_COUNT > 3u) m.a.w = componentChoiceWeight(m.mode, SAMPLER, MODEL_3, m.C3, wo);
   vec4 P = combinedChoiceProbabilities(m.mode, COMPONENT_COUNT, m.a);
   m.c = combinedMisProbabilities(P);
   // Delta components take no light samples and have no MIS density: their c is dropped.
@@ -415,9 +434,14 @@ void main() {
   float etaScale = throughput.w;
   vec3 L = vec3(0.0f);
   if (GUIDING) guideRecordArrival(path, bounce, x);  // training record (guiding.h)
+  bool frontFace = dot(ngFront, dir) < 0.0f;
+
+  // ---- Beer-Lambert: a ray that meets an absorbing material from the back came from inside ----
+  // (shared/volume.h; docs/scenes.md, "Volumes"): the segment of length hit.x (dir is a unit
+  // vector) is attenuated before anything at this vertex counts.
+  if ((M.info.y & MATERIAL_ABSORBING) != 0u && !frontFace) beta *= volumeTransmittance(M.absorption.xyz, hit.x);
 
   // ---- Emission: one-sided emitters radiate along their geometric normal ----
-  bool frontFace = dot(ngFront, dir) < 0.0f;
   if ((M.info.y & MATERIAL_EMISSIVE) != 0u && frontFace) {
     float w = 1.0f;
     if (bounce > 0u && prevPdf > 0.0f) {  // reached by a BSDF sample that light sampling could also make
@@ -447,7 +471,11 @@ void main() {
   vec3 xo = offsetRay(x, ng);
   bool last = bounce >= g.maxDepth;
 
-  ShadeMaterial m = shadeMaterial(M, x, wo, roulette);
+  float transmissionR = -1.0f;  // the transmission texture at the hit (combined materials only)
+#if SHADE_COMBINED
+  if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) transmissionR = transmissionAt(S.info.x, tri, hit.y, hit.z);
+#endif
+  ShadeMaterial m = shadeMaterial(M, x, wo, roulette, transmissionR);
   if (!last && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m))
     nextEvent(m, path, key, bounce, lighting, xo, ng, tt, bb, ns, wo, beta);
 

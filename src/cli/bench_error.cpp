@@ -130,6 +130,9 @@ struct PointConfig {
   int reps = 16;
 };
 
+// Timed repetitions of 2^20 samples per strategy and case (median; sample_run.h).
+constexpr std::uint32_t kTimingRepeats = 5;
+
 std::vector<Curve> runPoint(vk::Context& ctx, const PointConfig& pc, Progress& progress, std::uint64_t& step) {
   std::vector<Curve> curves;
   const std::uint64_t n = std::uint64_t(1) << pc.maxLog2;
@@ -179,16 +182,19 @@ std::vector<Curve> runPoint(vk::Context& ctx, const PointConfig& pc, Progress& p
           Curve c[2];
           std::vector<double> sq(pc.maxLog2 + 1, 0.0);
           std::vector<double> sq1(pc.maxLog2 + 1, 0.0);
-          double sum[2] = {0, 0}, sumSq[2] = {0, 0}, seconds = 0;
+          double sum[2] = {0, 0}, sumSq[2] = {0, 0}, secPerSample = 0;
           std::uint64_t failed = 0, trialFailures = 0;
           std::uint32_t set = s == SAMPLER_QUADTREE ? qSet[0] : (s == SAMPLER_TABULATED ? tSet[0] : INVALID_INDEX);
           for (int r0 = 0; r0 < pc.reps; r0 += int(repsPerCall)) {
             int rn = std::min<int>(int(repsPerCall), pc.reps - r0);
             // Seed per call; within a call repetition r owns indices [r n, (r + 1) n).
+            // The first call also times 2^20 samples (or all, if fewer) kTimingRepeats times: the
+            // time per sample is their median, robust to a busy machine.
             quadtree::SampleBatch b = quadtree::sampleGpu(ctx, qt, set, m->id, p, v, std::uint32_t(rn * n),
                                                           0x5eed0000u + std::uint32_t(r0), s,
-                                                          s == SAMPLER_TABULATED ? &tab : nullptr, true);
-            seconds += b.seconds;
+                                                          s == SAMPLER_TABULATED ? &tab : nullptr, true,
+                                                          r0 == 0 ? kTimingRepeats : 0);
+            if (r0 == 0) secPerSample = b.medianSecondsPerSample;
             trialFailures += b.trialFailures;
             for (int r = 0; r < rn; ++r) {
               double acc[2] = {0, 0};
@@ -227,7 +233,7 @@ std::vector<Curve> runPoint(vk::Context& ctx, const PointConfig& pc, Progress& p
             cv.strategy = s;
             cv.integrand = q;
             cv.ref = ref[q];
-            cv.secPerSample = seconds / total;
+            cv.secPerSample = secPerSample;
             cv.failed = failed;
             cv.samples = std::uint64_t(total);
             cv.trialFailures = trialFailures;

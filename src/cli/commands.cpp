@@ -20,6 +20,7 @@
 #include "io/image.h"
 #include "quadtree/sampler_tables.h"
 #include "render/guide.h"
+#include "render/mlt_integrator.h"
 #include "render/render_loop.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
@@ -51,6 +52,11 @@ struct RenderArgs {
   std::string components = "albedo";
   std::string roulette = "throughput";
   std::string traversal = "auto";
+  std::string integrator = "path";
+  std::uint32_t mltChains = 65536;
+  std::uint32_t mltBootstrap = 0;
+  float mltLargeStep = 0.3f;
+  float mltSigma = 0.01f;
   std::string guiding = "off";
   std::uint32_t guideTrain = 0;
   double guideMemoryMiB = 16;
@@ -91,11 +97,28 @@ int renderCommand(const RenderArgs& a) {
   parseComponentSelection(a.components, s.components);
   parseRouletteMode(a.roulette, s.roulette);
   parseTraversal(a.traversal, s.traversal);
+  if (!parseIntegrator(a.integrator, s.integrator))
+    throw Error("--integrator " + a.integrator + ": unknown integrator (path or mlt)");
+  s.mltChains = a.mltChains;
+  s.mltBootstrap = a.mltBootstrap;
+  s.mltLargeStep = a.mltLargeStep;
+  s.mltSigma = a.mltSigma;
   s.guiding = a.guiding == "on";
   s.guideTrainSpp = a.guideTrain;
   s.guideSpatialThreshold = a.guideSpatial;
   s.guideAlpha = a.guideAlpha;
   s.guideMemory = static_cast<std::uint64_t>(a.guideMemoryMiB * 1048576.0);
+  // What Metropolis renders do not support yet (docs/mlt.md): their chains live on the device
+  // only, so a file cannot continue them; guiding and the variance of a correlated estimate.
+  if (s.integrator == IntegratorKind::Mlt) {
+    if (!a.resume.empty())
+      throw Error("--resume with --integrator mlt: a Metropolis render cannot be resumed (its chains are not in the "
+                  "file; docs/mlt.md)");
+    if (s.guiding) throw Error("--integrator mlt with --guiding on: not supported (docs/mlt.md)");
+    if (a.variance)
+      throw Error("--variance with --integrator mlt: the Metropolis estimate has no per-sample variance (its samples "
+                  "are correlated; docs/mlt.md)");
+  }
   if (s.guiding && !a.resume.empty())
     throw Error("--resume with --guiding on: a guided render cannot be resumed yet (its guide is not in the file; "
                 "issue 16)");
@@ -194,13 +217,13 @@ int renderCommand(const RenderArgs& a) {
                      sum.samplerCacheMisses, sum.samplerCacheRejected);
       std::string budget = a.timeBudget > 0 ? ", time budget " + std::to_string(a.timeBudget) + " s" : "";
       std::fprintf(stderr, "device: %s (%s); %ux%u, %s spp%s%s (%u per pass), max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
-                           "roulette %s, traversal %s%s\n",
+                           "roulette %s, traversal %s, integrator %s%s\n",
                    ctx.deviceName.c_str(), ctx.driverInfo.c_str(), s.width, s.height,
                    targetSpp == (1u << 30) ? "unlimited" : std::to_string(targetSpp).c_str(),
                    a.resume.empty() ? "" : (" (resuming from " + std::to_string(previous.spp) + ")").c_str(),
                    budget.c_str(), renderer.samplesPerPass(), s.maxDepth, s.seed, lightingModeName(s.lighting), rngModeName(s.rng),
                    samplerName(s.sampler), rouletteModeName(s.roulette), traversalName(sum.traversal),
-                   s.guiding ? (", guiding on (" + std::to_string(sum.guideTrainSpp) + " training spp)").c_str() : "");
+                   integratorName(s.integrator), s.guiding ? (", guiding on (" + std::to_string(sum.guideTrainSpp) + " training spp)").c_str() : "");
     }
 
     base.totalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();  // set-up
@@ -223,6 +246,15 @@ int renderCommand(const RenderArgs& a) {
                      r.dirThreshold, r.capped ? ", memory cap reached" : "");
       std::fprintf(stderr, "guiding: %u training spp, %.3f s of CPU time reading records, splatting and refining\n",
                    renderer.summary().guideTrainSpp, guide->trainingSeconds());
+    }
+    if (const MltIntegrator* mlt = renderer.mlt(); mlt && !a.quiet) {
+      const MltReport& m = mlt->report();
+      std::fprintf(stderr, "mlt: %u chains of %u primary draws; bootstrap %u paths (%llu with f > 0), b = %.6g, in %.2f s; "
+                           "%llu mutations, acceptance %.1f %% (large steps %.1f %% of them, accepted %.1f %%)\n",
+                   m.chains, m.dims, m.bootstrapPaths, static_cast<unsigned long long>(m.nonzeroBootstrap), m.b,
+                   m.bootstrapSeconds, static_cast<unsigned long long>(m.proposals), 100.0 * m.acceptance(),
+                   m.proposals ? 100.0 * double(m.largeProposals) / double(m.proposals) : 0.0,
+                   m.largeProposals ? 100.0 * double(m.largeAccepted) / double(m.largeProposals) : 0.0);
     }
     if (rec.interrupted)
       std::fprintf(stderr, "interrupted by %s after %u of %u spp: writing what has accumulated\n",
@@ -266,6 +298,8 @@ int mergeCommand(const std::vector<std::string>& inputs, const std::string& outp
     ImageMetadata meta;
     Image img = readExr(inputs[k], &meta);
     RenderRecord r = readRecord(inputs[k], meta);
+    if (r.settings.integrator == IntegratorKind::Mlt)
+      throw Error(inputs[k] + ": rendered with --integrator mlt; merging Metropolis renders is not supported (docs/mlt.md)");
     r.settings.width = static_cast<std::uint32_t>(img.width);
     r.settings.height = static_cast<std::uint32_t>(img.height);
     if (img.sum.empty() || img.sumSq.empty())
@@ -671,6 +705,18 @@ int runCli(int argc, char** argv) {
   render->add_option("--checkpoint", ra.checkpointSeconds, "Write the image so far to the output every this many seconds "
                                                           "(resumable with --resume; 0: never)")
       ->capture_default_str()->check(CLI::Range(0.0, 1e9));
+  render->add_option("--integrator", ra.integrator, "Integrator: path (the wavefront path tracer) or mlt (primary-"
+                                                   "sample-space Metropolis over it; docs/mlt.md)")
+      ->capture_default_str();
+  render->add_option("--mlt-chains", ra.mltChains, "mlt: Markov chains in flight (each a path per mutation)")
+      ->capture_default_str()->check(CLI::Range(64u, 4194240u));
+  render->add_option("--mlt-bootstrap", ra.mltBootstrap, "mlt: independent bootstrap paths for the normalisation and "
+                                                         "the chains' starts (0: 4 x chains)")
+      ->capture_default_str();
+  render->add_option("--mlt-large-step", ra.mltLargeStep, "mlt: probability of a large step (an independent path)")
+      ->capture_default_str()->check(CLI::Range(0.0f, 1.0f));
+  render->add_option("--mlt-sigma", ra.mltSigma, "mlt: standard deviation of a small step per primary coordinate")
+      ->capture_default_str()->check(CLI::Range(1e-6f, 1.0f));
   render->add_option("--guiding", ra.guiding, "Path guiding (docs/guiding.md): on = sample directions from a guide "
                                               "learned from the render's first samples (one-sample MIS with the BSDF "
                                               "sampler), off = BSDF sampling only")

@@ -95,7 +95,8 @@ SampleBatch sampleCpuStrategy(std::uint32_t strategy, const sampling::TabulatedT
 
 SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32_t set, std::uint32_t model,
                       const BrdfParams& params, vec3 v, std::uint32_t n, std::uint32_t seed, std::uint32_t strategy,
-                      const sampling::TabulatedTables* tab, bool warmUp) {
+                      const sampling::TabulatedTables* tab, bool warmUp, std::uint32_t timingRepeats,
+                      std::uint32_t timingCount) {
   if (strategy == SAMPLER_TABULATED && !tab) throw std::invalid_argument("sampleGpu: tabulated needs its tables");
   SampleBatch out;
   auto upload = [&](const void* data, std::size_t bytes, const char* what) {
@@ -162,20 +163,40 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
     vk::endOneShot(ctx, cmd);
     std::memset(stats.mapped, 0, STAT_COUNT * 4);
   }
-  auto t0 = std::chrono::steady_clock::now();
-  // Chunks of at most 65535 workgroups (maxComputeWorkGroupCount on lavapipe).
-  const std::uint32_t chunk = 65535u * WORKGROUP_SIZE;
-  for (std::uint32_t first = 0; first < n; first += chunk) {
-    std::uint32_t count = std::min(chunk, n - first);
-    pc.count = count;
-    pc.first = first;
-    VkCommandBuffer cmd = vk::beginOneShot(ctx);
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &dset, 0, nullptr);
-    vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
-    vkCmdDispatch(cmd, (count + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE, 1, 1);
-    vk::endOneShot(ctx, cmd);
+  // Samples [0, count) in chunks of at most 65535 workgroups (maxComputeWorkGroupCount on lavapipe).
+  auto dispatchSamples = [&](std::uint32_t count) {
+    const std::uint32_t chunk = 65535u * WORKGROUP_SIZE;
+    for (std::uint32_t first = 0; first < count; first += chunk) {
+      pc.count = std::min(chunk, count - first);
+      pc.first = first;
+      VkCommandBuffer cmd = vk::beginOneShot(ctx);
+      vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipe.pipeline);
+      vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &dset, 0, nullptr);
+      vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
+      vkCmdDispatch(cmd, (pc.count + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE, 1, 1);
+      vk::endOneShot(ctx, cmd);
+    }
+  };
+  if (timingRepeats > 0) {
+    // The benchmarks' time per sample: the median of repeated timings of the same dispatches
+    // (deterministic: they rewrite the same outputs), robust to a busy machine's spikes. Before
+    // the batch, so that their sampler counters are cleared.
+    const std::uint32_t m = std::min(n, timingCount);
+    std::vector<double> perSample;
+    for (std::uint32_t r = 0; r < timingRepeats && m > 0; ++r) {
+      auto t = std::chrono::steady_clock::now();
+      dispatchSamples(m);
+      perSample.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count() / m);
+    }
+    if (!perSample.empty()) {
+      std::sort(perSample.begin(), perSample.end());
+      const std::size_t h = perSample.size() / 2;
+      out.medianSecondsPerSample = perSample.size() % 2 ? perSample[h] : 0.5 * (perSample[h - 1] + perSample[h]);
+    }
+    std::memset(stats.mapped, 0, STAT_COUNT * 4);
   }
+  auto t0 = std::chrono::steady_clock::now();
+  dispatchSamples(n);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.wPdf.resize(n);
   out.fOk.resize(n);

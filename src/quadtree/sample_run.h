@@ -21,6 +21,7 @@ struct SampleBatch {
   std::uint64_t nodeReads = 0;     // CPU only: inner nodes read by the tree descents
   std::vector<std::uint64_t> leafEvaluations, leafAccepted;  // CPU only: per leaf of `tables`
   double seconds = 0;
+  double medianSecondsPerSample = 0;  // GPU with timingRepeats > 0: median of the repeated timings
 };
 
 SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint32_t model, const shared::BrdfParams& params,
@@ -38,9 +39,12 @@ SampleBatch sampleCpuStrategy(std::uint32_t strategy, const sampling::TabulatedT
 // seconds = wall time of the dispatches alone (pipeline and buffers are made before; the first
 // dispatch includes lavapipe's lazy shader compilation unless warmUp).
 // warmUp: run one small untimed dispatch first (for benchmarks).
+// timingRepeats > 0: before the batch, time the dispatches of the first min(n, timingCount)
+// samples that many times and report the median time per sample (medianSecondsPerSample).
 SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32_t set, std::uint32_t model,
                       const shared::BrdfParams& params, shared::vec3 v, std::uint32_t n, std::uint32_t seed,
                       std::uint32_t strategy = SAMPLER_QUADTREE, const sampling::TabulatedTables* tab = nullptr,
-                      bool warmUp = false);
+                      bool warmUp = false, std::uint32_t timingRepeats = 0,
+                      std::uint32_t timingCount = std::uint32_t(1) << 20);
 
 }  // namespace nusselt::quadtree

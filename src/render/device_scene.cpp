@@ -69,8 +69,6 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene, TraversalStructur
   // Texture coordinates in the same order, only for a scene with textures (absent sets read (0, 0)).
   const bool textured = sceneUsesTextures(scene);
   std::vector<shared::GpuTriTexcoords> texcoords(textured ? std::max<std::size_t>(triCount, 1) : 1);
-  const bool has0 = scene.texcoords0.size() == scene.positions.size();
-  const bool has1 = scene.texcoords1.size() == scene.positions.size();
   // Tangents (3 vec4 per triangle) only for a scene with a normal map.
   const bool normalMapped = sceneUsesNormalMaps(scene);
   std::vector<glm::vec4> tangents(normalMapped ? 3 * std::max<std::size_t>(triCount, 1) : 1, glm::vec4(0.0f));
@@ -92,16 +90,7 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene, TraversalStructur
     shading[k].n0 = v4(scene.normals[3 * src]);
     shading[k].n1 = v4(scene.normals[3 * src + 1]);
     shading[k].n2 = v4(scene.normals[3 * src + 2]);
-    if (textured) {
-      glm::vec2 a[3]{}, b[3]{};
-      for (int c = 0; c < 3; ++c) {
-        if (has0) a[c] = scene.texcoords0[3 * src + c];
-        if (has1) b[c] = scene.texcoords1[3 * src + c];
-      }
-      texcoords[k].a = glm::vec4(a[0], a[1]);
-      texcoords[k].b = glm::vec4(a[2], b[0]);
-      texcoords[k].c = glm::vec4(b[1], b[2]);
-    }
+    if (textured) texcoords[k] = packTriTexcoords(scene, src);
     if (normalMapped)
       for (int c = 0; c < 3; ++c) tangents[3 * k + c] = scene.tangents[3 * src + c];
     std::uint32_t mat = scene.triangleMaterial[src];

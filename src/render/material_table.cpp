@@ -168,10 +168,12 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     if (src.combined()) flags |= MATERIAL_COMBINED;
     if (used[i] && textureUse(src, scene).any()) flags |= MATERIAL_TEXTURED;
     if (used[i] && textureUse(src, scene).alpha) flags |= MATERIAL_ALPHA;
+    if (src.absorbs()) flags |= MATERIAL_ABSORBING;
     const std::uint32_t material = static_cast<std::uint32_t>(i);
     dst.info = glm::uvec4(src.combined() ? src.components[0].model : src.model, flags,
                           src.combined() ? INVALID_INDEX : setFor(material, -1), slot);
     dst.emission = v4(src.emission);
+    dst.absorption = v4(src.absorption);
     dst.params = src.params;
     if (used[i] && !src.combined()) gpuMeasured(src.model, dst.params);
     dst.components = glm::uvec4(0u);

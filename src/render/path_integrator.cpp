@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "../../shaders/shared/layout.h"
+#include "../../shaders/shared/rng.h"
 #include "render/guide.h"
 #include "util/error.h"
 
@@ -33,19 +34,26 @@ std::uint32_t PathIntegrator::samplesPerPassFor(const RenderSettings& settings, 
   return static_cast<std::uint32_t>(std::max<std::uint64_t>(k, 1));
 }
 
-std::uint64_t PathIntegrator::bytesFor(std::uint32_t capacity, std::size_t slots) {
-  // Nine vec4 arrays of path and shadow-ray state, the queues (counters and item arrays).
-  return std::uint64_t(capacity) * 9 * 16 + (QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + slots) * std::uint64_t(capacity)) * 4;
+std::uint64_t PathIntegrator::bytesFor(std::uint32_t capacity, std::size_t slots, std::uint32_t primaryDims) {
+  // Nine vec4 arrays of path and shadow-ray state, the queues (counters and item arrays), the
+  // primary sample vectors.
+  return std::uint64_t(capacity) * 9 * 16 + (QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + slots) * std::uint64_t(capacity)) * 4 +
+         std::uint64_t(shared::primarySampleSlots(capacity)) * primaryDims * 8;
+}
+
+std::uint32_t PathIntegrator::primaryDimsFor(std::uint32_t maxDepth) {
+  return shared::rngDimension(maxDepth, RNG_DIMS_PER_BOUNCE - 1u) + 1u;
 }
 
 PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
                                const std::vector<std::vector<std::uint32_t>>& slotKeys, std::uint64_t pixels,
                                std::uint32_t samplesPerPass, const std::vector<std::string>& slotNames,
-                               DeviceGuide* guide)
-    : m_ctx(ctx), m_globals(globals), m_settings(settings), m_slotKeys(slotKeys), m_pixels(pixels), m_guide(guide) {
+                               DeviceGuide* guide, const PathOptions& options)
+    : m_ctx(ctx), m_globals(globals), m_settings(settings), m_slotKeys(slotKeys), m_pixels(pixels), m_guide(guide),
+      m_options(options) {
   for (std::size_t s = 0; s < m_slotKeys.size(); ++s)
     m_shadeMarks.push_back("shade " + (s < slotNames.size() ? slotNames[s] : std::to_string(s)));
-  m_capacity = capacityFor(settings, pixels, samplesPerPass);
+  m_capacity = options.capacity ? options.capacity : capacityFor(settings, pixels, samplesPerPass);
   const std::uint64_t cap = m_capacity;
   auto make = [&](VkDeviceSize bytes, const std::string& what, VkBufferUsageFlags usage = 0,
                   bool host = false) -> vk::Buffer* {
@@ -73,6 +81,11 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   std::memset(m_stats->mapped, 0, STAT_BUFFER_UINTS * 4);
   m_raysPerBounce.assign(STAT_BOUNCE_SLOTS, 0);
   g.stats = m_stats->address;
+  // The primary sample vectors (none by default).
+  if (m_options.primaryDims)
+    m_primarySamples = make(std::uint64_t(shared::primarySampleSlots(m_capacity)) * m_options.primaryDims * 8, "primary samples");
+  g.primaryDims = m_options.primaryDims;
+  g.primarySamples = m_primarySamples ? m_primarySamples->address : 0;
   g.maxDepth = m_settings.maxDepth;
   g.pathCapacity = m_capacity;
   // The escape stage exists only for scenes with an environment (the device scene set it up).
@@ -129,7 +142,13 @@ void PathIntegrator::mark(VkCommandBuffer cmd, const char* stage) {
 
 void PathIntegrator::createPipelines() {
   const VkPipelineLayout layout = m_globals.layout();
-  m_camera = vk::createComputePipeline(m_ctx, layout, "camera");
+  // Constant 11 (stage_common.glsl): PRIMARY_SAMPLES, in the stages that draw a path's numbers
+  // (camera, shade, escape) when the paths read primary sample vectors.
+  const std::uint32_t primary = m_options.primaryDims ? 1u : 0u;
+  if (primary)
+    m_camera = vk::createComputePipeline(m_ctx, layout, "camera",
+                                         {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, primary, m_options.imageSamples ? 1u : 0u});
+  else m_camera = vk::createComputePipeline(m_ctx, layout, "camera");
   // The tracing stages' module for the traversal (the Renderer resolved Auto): <stage>_rq with ray
   // queries, <stage> with the GLSL BVH (CMakeLists.txt). Only the used one is compiled.
   const std::string tracing = m_settings.traversal == Traversal::RayQuery ? "_rq" : "";
@@ -143,9 +162,9 @@ void PathIntegrator::createPipelines() {
   // Constant 10 (stage_common.glsl): GUIDING, in the shade and escape stages of guided renders.
   const std::uint32_t guiding = m_guide ? 1u : 0u;
   if (m_hasEscape) {
-    if (m_guide)
+    if (m_guide || primary)
       m_escape = vk::createComputePipeline(m_ctx, layout, "escape_f",
-                                           {0, 0, 0, 0, 0, 0, 0, 1u, m_hasTextures ? 1u : 0u, 0u, guiding});
+                                           {0, 0, 0, 0, 0, 0, 0, 1u, m_hasTextures ? 1u : 0u, 0u, guiding, primary});
     else m_escape = vk::createComputePipeline(m_ctx, layout, "escape");
   }
   m_accumulate = vk::createComputePipeline(m_ctx, layout, "accumulate");
@@ -174,9 +193,10 @@ void PathIntegrator::createPipelines() {
           spec.resize(7, 0u);
           spec.push_back(m_hasEscape ? 1u : 0u);
           spec.push_back(m_hasTextures ? 1u : 0u);  // constant 8: HAS_TEXTURES
-          if (guiding) {
+          if (guiding || primary) {
             spec.push_back(0u);       // constant 9: HAS_ALPHA (tracing stages only)
             spec.push_back(guiding);  // constant 10: GUIDING
+            spec.push_back(primary);  // constant 11: PRIMARY_SAMPLES
           }
           // One module per strategy (CMakeLists.txt): shade_sN / shade_combined_sN, and _f with the
           // texture and guiding code for the scenes and renders that use them.
@@ -185,7 +205,7 @@ void PathIntegrator::createPipelines() {
           const bool perModel = key[0] == 0 && sampler == SAMPLER_QUADTREE;
           const std::string module = std::string(key[0] > 0 ? "shade_combined" : "shade") +
                                      (perModel ? "_m" + std::to_string(key[1]) : std::string()) + "_s" +
-                                     std::to_string(sampler) + (m_hasTextures || guiding ? "_f" : "");
+                                     std::to_string(sampler) + (m_hasTextures || guiding || primary ? "_f" : "");
           m_shade[s] = vk::createComputePipeline(m_ctx, layout, module, spec);
         } catch (const std::exception& e) {
           errors[s] = e.what();
@@ -207,7 +227,7 @@ void PathIntegrator::emptyTraceArgs(VkCommandBuffer cmd, std::uint32_t parity) {
   vkCmdFillBuffer(cmd, m_args->buffer, (ARGS_TRACE0 + parity) * sizeof(DispatchArgs), sizeof(DispatchArgs), 0);
 }
 
-void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
+void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, bool accumulate) {
   const std::uint32_t slots = static_cast<std::uint32_t>(m_slotKeys.size());
   const VkPipelineLayout layout = m_globals.layout();
   const VkDescriptorSet set = m_globals.set();
@@ -289,6 +309,7 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount) {
     vk::computeBarrier(cmd);
     // (shade(maxDepth) queues no shadow rays: the last bounce takes no light sample.)
   }
+  if (!accumulate) return;
   bindAndPush(m_accumulate);
   vkCmdDispatch(cmd, groups, 1, 1);
   vk::computeBarrier(cmd);
@@ -335,12 +356,16 @@ void PathIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples
     }
     // Path guiding's training: this chunk's records and final radiance, splatted in path order.
     if (m_guide && m_guide->recording()) m_guide->consumeChunk(*m_pathRadiance, count);
-    // Fold the 32-bit device counters into 64-bit totals and restart them.
-    std::uint32_t* s = static_cast<std::uint32_t*>(m_stats->mapped);
-    m_totals.addDevice(s);
-    for (std::uint32_t b = 0; b < STAT_BOUNCE_SLOTS; ++b) m_raysPerBounce[b] += s[STAT_PER_BOUNCE + b];
-    std::memset(s, 0, STAT_BUFFER_UINTS * 4);
+    foldStats();
   }
+}
+
+void PathIntegrator::foldStats() {
+  // Fold the 32-bit device counters into 64-bit totals and restart them.
+  std::uint32_t* s = static_cast<std::uint32_t*>(m_stats->mapped);
+  m_totals.addDevice(s);
+  for (std::uint32_t b = 0; b < STAT_BOUNCE_SLOTS; ++b) m_raysPerBounce[b] += s[STAT_PER_BOUNCE + b];
+  std::memset(s, 0, STAT_BUFFER_UINTS * 4);
 }
 
 void PathIntegrator::addStats(const RenderStats& c) { m_totals.add(c); }

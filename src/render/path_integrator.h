@@ -17,6 +17,21 @@ namespace nusselt {
 
 class DeviceGuide;
 
+// How the path tracer draws a path's random numbers (stage_common.glsl, "primary sample source").
+struct PathOptions {
+  // 0: every number hashes (pixel, sample index, dimension, seed), the default. > 0: the stages
+  // are specialised with PRIMARY_SAMPLES (constant 11) and path slot i of a chunk reads its first
+  // primaryDims 2-D draws from primarySamples() (draw d at shared::primarySampleIndex(i, d,
+  // primaryDims), layout.h): a path is then a function of that vector (primaryDimsFor covers
+  // every draw of a path).
+  std::uint32_t primaryDims = 0;
+  // With primaryDims: draw 0 places the camera ray anywhere on the image and the path's pixel
+  // follows from it (camera constant 12, IMAGE_SAMPLES; Metropolis chains move across pixels).
+  bool imageSamples = false;
+  // Path slots (paths per chunk); 0: capacityFor(settings, pixels, samplesPerPass).
+  std::uint32_t capacity = 0;
+};
+
 class PathIntegrator : public Integrator {
  public:
   // slotKeys: the material table's shade slots (one specialised shade pipeline each).
@@ -26,7 +41,7 @@ class PathIntegrator : public Integrator {
   PathIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
                  const std::vector<std::vector<std::uint32_t>>& slotKeys, std::uint64_t pixels,
                  std::uint32_t samplesPerPass, const std::vector<std::string>& slotNames,
-                 DeviceGuide* guide = nullptr);
+                 DeviceGuide* guide = nullptr, const PathOptions& options = {});
   ~PathIntegrator() override;
 
   // Paths traced together in one chunk of a pass of `samples` samples per pixel (one indirect
@@ -36,20 +51,35 @@ class PathIntegrator : public Integrator {
   // 2^18 paths in flight on a CPU device and 2^21 on a GPU, at most 64 and at most spp; never so
   // many that pixels x samples overflows 32 bits.
   static std::uint32_t samplesPerPassFor(const RenderSettings& settings, std::uint64_t pixels, bool cpuDevice);
-  // Device bytes of the path state and queues.
-  static std::uint64_t bytesFor(std::uint32_t capacity, std::size_t slots);
+  // Device bytes of the path state and queues (and of the primary sample vectors, primaryDims per path).
+  static std::uint64_t bytesFor(std::uint32_t capacity, std::size_t slots, std::uint32_t primaryDims = 0);
+  // The 2-D draws a path of at most maxDepth bounces can make: the camera's and every bounce's
+  // dimensions (rng.h, rngDimension), so that with PathOptions::primaryDims = this no number hashes.
+  static std::uint32_t primaryDimsFor(std::uint32_t maxDepth);
 
   void renderPass(std::uint32_t sampleIndex, std::uint32_t samples) override;
+  // For integrators that drive the path tracer (mlt): records the tracing of path slots
+  // 0 .. paths - 1 (camera and bounces, no accumulation into the film) into cmd, with the globals
+  // the caller uploaded (chunkFirst 0, chunkPaths = paths, passSamples 1); after the submission
+  // has completed, foldStats() adds its counters to stats().
+  void recordTrace(VkCommandBuffer cmd, std::uint32_t paths) { recordPass(cmd, paths, false); }
+  void foldStats();
   RenderStats stats() const override { return m_totals; }
   void addStats(const RenderStats& carried) override;
   const std::vector<std::pair<std::string, double>>& stageSeconds() const override { return m_stageSeconds; }
   std::uint64_t deviceBytes() const override;
   const std::vector<std::uint64_t>& raysPerBounce() const override { return m_raysPerBounce; }
   double pipelineSeconds() const { return m_pipelineSeconds; }
+  // Paths per chunk (the slots of the path state).
+  std::uint32_t capacity() const { return m_capacity; }
+  // Per path slot: the radiance of its last traced path (rgb).
+  const vk::Buffer& pathRadiance() const { return *m_pathRadiance; }
+  // primarySampleSlots(capacity()) x PathOptions::primaryDims vec2s (only when primaryDims > 0).
+  vk::Buffer& primarySamples() { return *m_primarySamples; }
 
  private:
   void createPipelines();
-  void recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount);
+  void recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, bool accumulate = true);
   // Empties queues [first, first + count): their counts and indirect dispatch sizes.
   void emptyQueues(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t count);
   // Empties the trace stage's dispatch size ARGS_TRACE0 + parity.
@@ -76,6 +106,8 @@ class PathIntegrator : public Integrator {
   bool m_hasAlpha = false;     // spec constant HAS_ALPHA of the tracing stages
   DeviceGuide* m_guide = nullptr;  // path guiding (guide.h): its records are read after every chunk
   vk::Buffer* m_pathRadiance = nullptr;
+  PathOptions m_options;
+  vk::Buffer* m_primarySamples = nullptr;
   std::vector<vk::ComputePipeline> m_shade;  // one per slot
   VkCommandBuffer m_cmd = VK_NULL_HANDLE;
   VkFence m_fence = VK_NULL_HANDLE;

@@ -108,6 +108,20 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
     meta.doubles.push_back({"nusselt/guideSpatial", r.settings.guideSpatialThreshold});
     meta.doubles.push_back({"nusselt/guideMemory", double(r.settings.guideMemory)});
   }
+  // The integrator's name (written only when it is not the path tracer: path headers are as
+  // before); "nusselt/integrator" describes it.
+  if (r.settings.integrator != IntegratorKind::Path) {
+    meta.strings.push_back({"nusselt/integratorName", integratorName(r.settings.integrator)});
+    if (r.settings.integrator == IntegratorKind::Mlt) {
+      meta.ints.push_back({"nusselt/mltChains", r.settings.mltChains});
+      meta.ints.push_back({"nusselt/mltBootstrap", mltBootstrapPaths(r.settings)});
+      meta.doubles.push_back({"nusselt/mltLargeStep", r.settings.mltLargeStep});
+      meta.doubles.push_back({"nusselt/mltSigma", r.settings.mltSigma});
+    }
+    for (auto& [name, value] : meta.strings)
+      if (name == "nusselt/integrator")
+        value = "primary-sample-space Metropolis (PSSMLT) over the wavefront path tracer (" + value + ")";
+  }
   if (r.source == "preview") meta.doubles.push_back({"nusselt/exposure", r.displayExposure});
   return meta;
 }
@@ -171,6 +185,15 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   r.envScale = findDouble(meta, "nusselt/envScale").value_or(1);
   r.envRotate = findDouble(meta, "nusselt/envRotate").value_or(0);
   r.envSelect = findString(meta, "nusselt/envSelect").value_or("half");
+  // Absent in path-traced renders (and files written before other integrators existed).
+  if (!parseIntegrator(findString(meta, "nusselt/integratorName").value_or("path"), r.settings.integrator))
+    throw Error(path + ": header attribute nusselt/integratorName names an unknown integrator");
+  if (r.settings.integrator == IntegratorKind::Mlt) {
+    r.settings.mltChains = static_cast<std::uint32_t>(findInt(meta, "nusselt/mltChains").value_or(0));
+    r.settings.mltBootstrap = static_cast<std::uint32_t>(findInt(meta, "nusselt/mltBootstrap").value_or(0));
+    r.settings.mltLargeStep = static_cast<float>(findDouble(meta, "nusselt/mltLargeStep").value_or(0.3));
+    r.settings.mltSigma = static_cast<float>(findDouble(meta, "nusselt/mltSigma").value_or(0.01));
+  }
   // Absent in unguided renders (and files written before guiding existed).
   r.settings.guiding = findString(meta, "nusselt/guiding").value_or("off") == "on";
   r.settings.guideTrainSpp = static_cast<std::uint32_t>(findInt(meta, "nusselt/guideTrainSpp").value_or(0));
@@ -186,7 +209,8 @@ std::string firstDifference(const RenderRecord& a, const RenderRecord& b) {
   };
   const RenderSettings &s = a.settings, &t = b.settings;
   for (const std::string& d :
-       {differ("the scene", a.scene, b.scene),
+       {differ("the integrator (--integrator)", integratorName(s.integrator), integratorName(t.integrator)),
+        differ("the scene", a.scene, b.scene),
         differ("the image size", std::to_string(s.width) + "x" + std::to_string(s.height),
                std::to_string(t.width) + "x" + std::to_string(t.height)),
         differ("the seed (--seed)", std::to_string(s.seed), std::to_string(t.seed)),

@@ -12,6 +12,7 @@
 #include "brdf/merl.h"
 #include "render/environment.h"
 #include "render/guide.h"
+#include "render/mlt_integrator.h"
 #include "render/path_integrator.h"
 #include "render/texture_table.h"
 #include "util/error.h"
@@ -55,6 +56,11 @@ Traversal resolveTraversal(const vk::Context& ctx, Traversal requested) {
 Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& settings)
     : m_ctx(ctx), m_settings(settings) {
   if (settings.width == 0 || settings.height == 0) throw Error("image size must be at least 1x1");
+  const bool mlt = settings.integrator == IntegratorKind::Mlt;
+  if (mlt && settings.guiding) throw Error("--integrator mlt with --guiding on: not supported (docs/mlt.md)");
+  if (mlt && (settings.mltChains == 0 || settings.mltChains > 65535u * WORKGROUP_SIZE))
+    throw Error("--mlt-chains " + std::to_string(settings.mltChains) + ": between 1 and " +
+                std::to_string(65535u * WORKGROUP_SIZE));
   m_settings.traversal = resolveTraversal(ctx, settings.traversal);
   m_summary.traversal = m_settings.traversal;
   const std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;
@@ -67,9 +73,12 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   {
     std::size_t lightBound = scene.lights.size();
     for (std::uint32_t m : scene.triangleMaterial) lightBound += scene.materials[m].emits() ? 1 : 0;
-    m_samplesPerPass = PathIntegrator::samplesPerPassFor(
-        settings, pixels, m_ctx.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
-    const std::uint32_t capacity = PathIntegrator::capacityFor(settings, pixels, m_samplesPerPass);
+    m_samplesPerPass = mlt ? std::min(MltIntegrator::iterationsPerPassFor(settings), std::max(settings.spp, 1u))
+                           : PathIntegrator::samplesPerPassFor(settings, pixels,
+                                                               m_ctx.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
+    const std::uint32_t capacity = mlt ? settings.mltChains : PathIntegrator::capacityFor(settings, pixels, m_samplesPerPass);
+    const std::uint32_t primaryDims =
+        settings.primarySamples || mlt ? PathIntegrator::primaryDimsFor(settings.maxDepth) : 0;
     auto mib = [](std::uint64_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
     const std::uint64_t envBytes = environmentBytes(effectiveEnvironment(scene));
     if (m_ctx.maxAllocation && envBytes > m_ctx.maxAllocation)
@@ -87,7 +96,9 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
                                                      m_settings.traversal == Traversal::RayQuery) + envBytes +
                                textureDeviceBytes(scene) + measured.size() * MERL_TABLE_FLOATS * sizeof(float) +
                                std::max<std::size_t>(scene.materials.size(), 1) * sizeof(shared::GpuMaterial) +
-                               Film::bytesFor(pixels) + PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS) +
+                               Film::bytesFor(pixels) +
+                               PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS, primaryDims) +
+                               (mlt ? MltIntegrator::bytesFor(capacity, primaryDims, mltBootstrapPaths(settings), pixels) : 0) +
                                (settings.guiding ? DeviceGuide::bytesFor(settings.guideMemory, capacity, settings.maxDepth) : 0);
     const std::uint64_t have = vk::deviceLocalHeapSize(m_ctx);
     // The film is the largest single buffer (16 bytes per pixel, twice): one allocation each.
@@ -157,10 +168,23 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
     m_summary.guiding = true;
     m_summary.guideTrainSpp = guideTrainingSpp(settings);
   }
+  PathOptions paths;
+  if (settings.primarySamples || mlt) paths.primaryDims = PathIntegrator::primaryDimsFor(settings.maxDepth);
+  if (mlt) {
+    paths.imageSamples = true;
+    paths.capacity = settings.mltChains;
+  }
   auto integrator = std::make_unique<PathIntegrator>(m_ctx, *m_globals, m_settings, m_materials->slotKeys(), pixels,
-                                                     m_samplesPerPass, m_materials->slotNames(), m_guide.get());
+                                                     m_samplesPerPass, m_materials->slotNames(), m_guide.get(), paths);
   m_summary.pipelineSeconds = integrator->pipelineSeconds();
-  m_integrator = std::move(integrator);
+  m_paths = integrator.get();
+  if (mlt) {
+    auto chains = std::make_unique<MltIntegrator>(m_ctx, *m_globals, m_settings, std::move(integrator), pixels);
+    m_mlt = chains.get();
+    m_integrator = std::move(chains);
+  } else {
+    m_integrator = std::move(integrator);
+  }
   m_globals->upload();
   m_summary.deviceBytes = m_scene->deviceBytes() + m_materials->deviceBytes() + m_film->deviceBytes() +
                           m_integrator->deviceBytes() + sizeof(Globals) + (m_guide ? m_guide->deviceBytes() : 0);

@@ -49,6 +49,8 @@ struct SceneSummary {
 Traversal resolveTraversal(const vk::Context& ctx, Traversal requested);
 
 class DeviceGuide;
+class PathIntegrator;
+class MltIntegrator;
 
 class Renderer {
  public:
@@ -90,6 +92,10 @@ class Renderer {
   // Path guiding's state (null for unguided renders): its training reports and times.
   const DeviceGuide* guide() const { return m_guide.get(); }
   const RenderSettings& settings() const { return m_settings; }
+  // The path tracer that traces this render's paths (tests read and write its path state).
+  PathIntegrator& paths() { return *m_paths; }
+  // The Metropolis integrator of an mlt render (its chains' report), null otherwise.
+  const MltIntegrator* mlt() const { return m_mlt; }
 
   // ---- Progressive use (the preview window) ----
   // Restart accumulation: the film is cleared and the sample index goes back to 0.
@@ -122,6 +128,8 @@ class Renderer {
   std::unique_ptr<Film> m_film;
   std::unique_ptr<DeviceGuide> m_guide;
   std::unique_ptr<Integrator> m_integrator;
+  PathIntegrator* m_paths = nullptr;  // m_integrator's path tracer
+  MltIntegrator* m_mlt = nullptr;     // m_integrator when it is Metropolis
 };
 
 }  // namespace nusselt

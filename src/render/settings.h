@@ -92,6 +92,12 @@ enum class Traversal : std::uint32_t { Auto, RayQuery, Bvh };
 inline constexpr EnumName<Traversal> kTraversalNames[] = {
     {Traversal::Auto, "auto"}, {Traversal::RayQuery, "rayquery"}, {Traversal::Bvh, "bvh"}};
 
+// The integrator of a render (`--integrator`): path = the wavefront path tracer; mlt = primary
+// sample space Metropolis light transport over it (issue 19, docs/mlt.md). Not a shader value.
+enum class IntegratorKind : std::uint32_t { Path, Mlt };
+inline constexpr EnumName<IntegratorKind> kIntegratorNames[] = {{IntegratorKind::Path, "path"},
+                                                                {IntegratorKind::Mlt, "mlt"}};
+
 inline const char* lightingModeName(LightingMode m) { return enumName(kLightingNames, m); }
 inline const char* samplerName(SamplerKind k) { return enumName(kSamplerNames, k); }
 inline const char* rngModeName(RngMode m) { return enumName(kRngNames, m); }
@@ -106,8 +112,11 @@ inline bool parseComponentSelection(const std::string& name, ComponentSelection&
 inline bool parseRouletteMode(const std::string& name, RouletteMode& m) { return parseEnum(kRouletteNames, name, m); }
 inline const char* traversalName(Traversal t) { return enumName(kTraversalNames, t); }
 inline bool parseTraversal(const std::string& name, Traversal& t) { return parseEnum(kTraversalNames, name, t); }
+inline const char* integratorName(IntegratorKind k) { return enumName(kIntegratorNames, k); }
+inline bool parseIntegrator(const std::string& name, IntegratorKind& k) { return parseEnum(kIntegratorNames, name, k); }
 
 struct RenderSettings {
+  IntegratorKind integrator = IntegratorKind::Path;
   std::uint32_t width = 512;
   std::uint32_t height = 512;
   std::uint32_t spp = 64;
@@ -153,7 +162,26 @@ struct RenderSettings {
   // splats in iteration k. Mueller et al.'s 12000 suits their 1280 x 720 images; small images
   // get few regions with it (docs/guiding.md, measurements).
   double guideSpatialThreshold = 12000;
+  // The path tracer reads every random number of a path from a primary sample vector in a buffer
+  // (PathOptions::primaryDims = PathIntegrator::primaryDimsFor(maxDepth); Renderer::paths()), which
+  // the caller fills: for tests of the primary sample source. Not a command-line option.
+  bool primarySamples = false;
+  // Metropolis (--integrator mlt, docs/mlt.md). Chains in flight (`--mlt-chains`; each a path slot
+  // and a primary sample vector of PathIntegrator::primaryDimsFor(maxDepth) draws).
+  std::uint32_t mltChains = 65536;
+  // Independent paths of the bootstrap (`--mlt-bootstrap`): the normalisation b and the chains'
+  // starts come from them; 0 = 4 x chains.
+  std::uint32_t mltBootstrap = 0;
+  // Probability of a large step (`--mlt-large-step`; Kelemen et al. and pbrt: 0.3).
+  float mltLargeStep = 0.3f;
+  // Standard deviation of a small step's move per coordinate (`--mlt-sigma`; pbrt: 0.01).
+  float mltSigma = 0.01f;
 };
+
+// The bootstrap paths of a Metropolis render (RenderSettings::mltBootstrap resolved).
+inline std::uint32_t mltBootstrapPaths(const RenderSettings& s) {
+  return s.mltBootstrap ? s.mltBootstrap : static_cast<std::uint32_t>(std::min<std::uint64_t>(4ull * s.mltChains, 1u << 30));
+}
 
 // The training samples per pixel of a guided render: settings.guideTrainSpp, or when 0 the
 // largest 2^K - 1 <= min(spp / 2, 127) (complete doubling iterations, at most half of the

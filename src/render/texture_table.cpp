@@ -4,6 +4,8 @@
 #include <map>
 #include <set>
 
+#include "../../shaders/shared/alpha.h"
+#include "../../shaders/shared/texture.h"
 #include "util/error.h"
 
 namespace nusselt {
@@ -18,6 +20,7 @@ MaterialTextureUse textureUse(const Material& m, const Scene& scene) {
   u.metallicRoughness = pbr && m.metallicRoughnessTexture.present();
   u.emissive = m.emits() && m.emissiveTexture.present();
   u.alpha = m.alphaMode != AlphaMode::Opaque;
+  u.transmission = m.transmissionTextured && m.transmissionTexture.present() && m.components.size() == 2;
   u.normal = m.normalTexture.present() && !scene.tangents.empty() && scene.tangents.size() == scene.positions.size();
   return u;
 }
@@ -76,12 +79,12 @@ GpuTexture packTexture(const TextureRef& ref, const TextureImage& image, std::ui
 }
 
 namespace {
-enum TextureSlot { SlotBaseColor, SlotMetallicRoughness, SlotEmissive, SlotNormal, SlotCoverage };
+enum TextureSlot { SlotBaseColor, SlotMetallicRoughness, SlotEmissive, SlotNormal, SlotCoverage, SlotTransmission };
 
 // Calls fn(material index, slot, reference, description) for every texture the renderer applies,
 // in the order of the texture records: per material (those a triangle uses), baseColor,
 // metallicRoughness, emissive, normal, then the coverage map (the base-colour texture read for
-// its alpha by a material whose base colour is not textured).
+// its alpha by a material whose base colour is not textured), then transmission.
 template <class F>
 void forEachAppliedTexture(const Scene& scene, F fn) {
   const std::vector<bool> used = usedMaterials(scene);
@@ -95,6 +98,7 @@ void forEachAppliedTexture(const Scene& scene, F fn) {
     if (u.normal) fn(i, SlotNormal, m.normalTexture, m.name + " normalTexture");
     if (u.alpha && m.baseColorTexture.present() && !u.baseColor)
       fn(i, SlotCoverage, m.baseColorTexture, m.name + " baseColorTexture (alpha)");
+    if (u.transmission) fn(i, SlotTransmission, m.transmissionTexture, m.name + " transmissionTexture");
   }
 }
 
@@ -132,6 +136,7 @@ TextureData buildTextureData(const Scene& scene) {
     g.baseColorFactor = m.baseColorFactor;
     g.factors = glm::vec4(m.metallicFactor, m.roughnessFactor, m.normalScale, m.alphaCutoff);
     g.alpha = glm::uvec4(static_cast<std::uint32_t>(m.alphaMode), INVALID_INDEX, 0u, 0u);
+    g.transmission = glm::uvec4(INVALID_INDEX, 0u, 0u, 0u);
   }
   forEachAppliedTexture(scene, [&](std::size_t i, TextureSlot slot, const TextureRef& ref, const std::string& what) {
     const TextureImage& image = appliedImage(scene, ref, what);
@@ -151,11 +156,43 @@ TextureData buildTextureData(const Scene& scene) {
       case SlotEmissive: g.maps.z = index; break;
       case SlotNormal: g.maps.w = index; break;
       case SlotCoverage: g.alpha.y = index; break;
+      case SlotTransmission: g.transmission.x = index; break;
     }
     // Coverage: the base-colour texture's alpha, for any model (its RGB applies to gltf_pbr only).
     if (slot == SlotBaseColor && textureUse(scene.materials[i], scene).alpha) g.alpha.y = index;
   });
   return d;
+}
+
+shared::GpuTriTexcoords packTriTexcoords(const Scene& scene, std::uint32_t triangle) {
+  const bool has0 = scene.texcoords0.size() == scene.positions.size();
+  const bool has1 = scene.texcoords1.size() == scene.positions.size();
+  glm::vec2 a[3]{}, b[3]{};
+  for (std::uint32_t c = 0; c < 3; ++c) {
+    if (has0) a[c] = scene.texcoords0[3 * triangle + c];
+    if (has1) b[c] = scene.texcoords1[3 * triangle + c];
+  }
+  shared::GpuTriTexcoords t;
+  t.a = glm::vec4(a[0], a[1]);
+  t.b = glm::vec4(a[2], b[0]);
+  t.c = glm::vec4(b[1], b[2]);
+  return t;
+}
+
+AlphaTester::AlphaTester(const Scene& scene, const std::vector<std::uint32_t>& order)
+    : m_scene(scene), m_order(order), m_data(buildTextureData(scene)) {}
+
+bool AlphaTester::operator()(std::uint32_t tri, float b1, float b2, glm::vec3 origin, glm::vec3 dir) const {
+  const std::uint32_t src = m_order.empty() ? tri : m_order[tri];
+  const std::uint32_t material = m_scene.triangleMaterial[src];
+  // MATERIAL_ALPHA (material_table.cpp): a used material with alphaMode MASK or BLEND.
+  if (!textureUse(m_scene.materials[material], m_scene).alpha || m_data.materials.empty()) return true;
+  const GpuMaterialTextures& T = m_data.materials[material];
+  float alpha = T.baseColorFactor.w;
+  if (T.alpha.y != INVALID_INDEX)
+    alpha *= shared::textureAtHit(m_data.texels.data(), m_data.textures[T.alpha.y], packTriTexcoords(m_scene, src), b1,
+                                  b2).w;
+  return shared::alphaTest(T.alpha.x, alpha, T.factors.w, tri, origin, dir);
 }
 
 }  // namespace nusselt

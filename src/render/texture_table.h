@@ -18,7 +18,8 @@ struct MaterialTextureUse {
   bool emissive = false;           // any material with a non-zero emission: RGB x emission
   bool normal = false;             // any material: the shading normal (needs Scene::tangents)
   bool alpha = false;              // any material: alphaMode MASK or BLEND (coverage in traversal)
-  bool any() const { return baseColor || metallicRoughness || emissive || normal || alpha; }
+  bool transmission = false;       // the transmission combination (Material::transmissionTextured)
+  bool any() const { return baseColor || metallicRoughness || emissive || normal || alpha || transmission; }
   // The BRDF's parameters (not only its emission) vary over the surface: no per-material
   // sampling tables fit it (the quadtree and tabulated samplers fall back to cosine).
   bool paramsVary() const { return baseColor || metallicRoughness; }
@@ -45,5 +46,25 @@ std::uint64_t textureDeviceBytes(const Scene& scene);
 shared::GpuTexture packTexture(const TextureRef& ref, const TextureImage& image, std::uint32_t firstTexel);
 // An image's texels as the texel buffer holds them.
 std::vector<std::uint32_t> packTexels(const TextureImage& image);
+
+// Both coordinate sets of scene triangle `triangle`'s corners as the GPU holds them ((0, 0) for a
+// set the scene lacks).
+shared::GpuTriTexcoords packTriTexcoords(const Scene& scene, std::uint32_t triangle);
+
+// The C++ twin of the GPU's alpha test in traversal (alphaPasses, stage_common.glsl), as a hit
+// filter for bvhClosestHit (scene/bvh.h): alpha = baseColorFactor.a x the base-colour texture's
+// alpha (texture.h's lookup on the packed textures), then shared/alpha.h's rule. `order` is the
+// GPU triangle order (Bvh::triangleOrder; BLEND's hash takes the triangle's index in it); empty:
+// the scene's order. Holds the scene and the order by reference.
+class AlphaTester {
+ public:
+  AlphaTester(const Scene& scene, const std::vector<std::uint32_t>& order);
+  bool operator()(std::uint32_t tri, float b1, float b2, glm::vec3 origin, glm::vec3 dir) const;
+
+ private:
+  const Scene& m_scene;
+  const std::vector<std::uint32_t>& m_order;
+  TextureData m_data;
+};
 
 }  // namespace nusselt

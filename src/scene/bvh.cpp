@@ -449,7 +449,8 @@ bool intersectTriangle(glm::vec3 origin, glm::vec3 dir, glm::vec3 v0, glm::vec3 
 }
 
 bool bvhClosestHit(const Bvh& bvh, const std::vector<glm::vec3>& positions, glm::vec3 origin,
-                   glm::vec3 dir, float tmin, float tmax, float& t, std::uint32_t& tri) {
+                   glm::vec3 dir, float tmin, float tmax, float& t, std::uint32_t& tri,
+                   const BvhHitFilter& passes) {
   if (bvh.nodes.empty()) return false;
   const RayBoxSetup ray = setupRay(origin, dir);
   std::uint32_t stack[BVH_STACK_SIZE];
@@ -463,7 +464,8 @@ bool bvhClosestHit(const Bvh& bvh, const std::vector<glm::vec3>& positions, glm:
       const glm::vec3 v0 = positions[3 * o];
       float tt, b1, b2;
       if (intersectTriangle(origin, dir, v0, positions[3 * o + 1] - v0, positions[3 * o + 2] - v0, tmin,
-                            best, tt, b1, b2)) {
+                            best, tt, b1, b2) &&
+          (!passes || passes(i, b1, b2, origin, dir))) {
         best = tt;
         tri = i;
         found = true;

@@ -18,6 +18,7 @@
 // the GPU traversal stack (it holds at most one deferred node per level).
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -62,12 +63,20 @@ Bvh buildBvh(const std::vector<glm::vec3>& positions);
 std::vector<std::uint32_t> mortonOrder(const std::vector<glm::vec3>& positions);
 
 // ---- Reference traversal (tests only) -----------------------------------------------------------
+// Whether a candidate hit counts: triangle tri (an index into the reordered array), barycentrics
+// (b1, b2) of v1 and v2, the ray. The GPU's rule is alphaPasses (stage_common.glsl); its C++ twin
+// for a scene is AlphaTester (src/render/texture_table.h).
+using BvhHitFilter = std::function<bool(std::uint32_t tri, float b1, float b2, glm::vec3 origin, glm::vec3 dir)>;
+
 // The C++ twin of traceClosest in bvh_traverse.glsl: same slab test, same Moller-Trumbore, same
 // stack discipline. positions are the ORIGINAL (not reordered) positions given to buildBvh; tri
 // is returned as an index into the reordered array (as on the GPU): the original triangle is
-// bvh.triangleOrder[tri]. Returns the nearest hit with tmin < t < tmax.
+// bvh.triangleOrder[tri]. Returns the nearest hit with tmin < t < tmax that `passes` accepts
+// (every hit without it: an opaque scene; with the scene's AlphaTester: MASK and BLEND as the GPU
+// traversal of a scene with alpha, HAS_ALPHA).
 bool bvhClosestHit(const Bvh& bvh, const std::vector<glm::vec3>& positions, glm::vec3 origin,
-                   glm::vec3 dir, float tmin, float tmax, float& t, std::uint32_t& tri);
+                   glm::vec3 dir, float tmin, float tmax, float& t, std::uint32_t& tri,
+                   const BvhHitFilter& passes = nullptr);
 
 // Moller-Trumbore against one triangle (v0, e1 = v1 - v0, e2 = v2 - v0), both faces, exactly as
 // the GPU computes it. Exposed so that tests can brute-force with the same arithmetic.

@@ -48,6 +48,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "../../shaders/shared/volume.h"
 #include "brdf/merl.h"
 #include "io/image_decode.h"
 #include "scene/gltf_compression.h"
@@ -1297,7 +1298,9 @@ class Converter {
       if (t->Has("thicknessTexture"))
         warnOnce("KHR_materials_volume thicknessTexture is ignored: a path tracer measures thickness in the geometry");
       double distance = number(*t, "attenuationDistance", f, INFINITY);
-      if (!(distance > 0)) fail(f + ".attenuationDistance: " + fmt(distance) + " is not > 0");
+      // (A positive distance below 1e-30 would round to a float 0.)
+      if (!(distance >= 1e-30))
+        fail(f + ".attenuationDistance: " + fmt(distance) + " is not a distance >= 1e-30 (metres)");
       m.attenuationDistance = distance > 1e30 ? INFINITY : float(distance);
       if (t->Has("attenuationColor")) {
         const tinygltf::Value& a = t->Get("attenuationColor");
@@ -1307,9 +1310,13 @@ class Converter {
           m.attenuationColor[k] = unit(a.Get(k).GetNumberAsDouble(), f + ".attenuationColor[" + str(k) + "]");
         }
       }
-      // Its presence (thicknessFactor > 0) makes the transmission refract (transmissiveMaterial);
-      // the attenuation inside is not rendered yet.
-      if (std::isfinite(m.attenuationDistance)) notRenderedYet("KHR_materials_volume attenuation");
+      // Its presence (thicknessFactor > 0) makes the transmission refract (transmissiveMaterial),
+      // and the attenuation then absorbs inside (Material::absorption). Without a refracting
+      // volume no path travels inside, and the attenuation is not rendered.
+      const bool refracts = m.thicknessFactor > 0.0f && m.transmissionFactor * (1.0f - m.metallicFactor) > 0.0f &&
+                            !gm.extensions.count("NUSSELT_brdf");
+      if (std::isfinite(m.attenuationDistance) && !refracts)
+        notRenderedYet("KHR_materials_volume attenuation without thicknessFactor > 0 and transmission");
     }
   }
 
@@ -1326,28 +1333,34 @@ class Converter {
     if (!(w > 0.0f)) return;
     const bool thin = !m.hasVolume || !(m.thicknessFactor > 0.0f);
     const ModelSpec& glassModel = *findModel(thin ? "thin_dielectric" : "dielectric");
+    // Beer-Lambert inside the refracting volume (shaders/shared/volume.h).
+    if (!thin) m.absorption = shared::volumeAbsorption(m.attenuationColor, m.attenuationDistance);
     BrdfParams glass = packParams(glassModel, {{"eta", ParamValue::num(std::min(m.ior, 10.0f))}},
                                   context + " (transmission)");
-    if (w >= 1.0f) {
+    // A transmission texture varies w over the surface: the combination even where w = 1.
+    const bool textured = m.transmissionTexture.present();
+    if (w >= 1.0f && !textured) {
       m.model = glassModel.id;
       m.params = glass;
       return;
     }
     MaterialComponent base;
     base.model = MODEL_GLTF_PBR;
-    base.weight = 1.0f - w;
+    base.weight = std::max(0.0f, 1.0f - w);
     base.params = m.params;
     MaterialComponent clear;
     clear.model = glassModel.id;
     clear.weight = w;
     clear.params = glass;
     m.components = {base, clear};
+    m.transmissionTextured = textured;
   }
 
   // The textures the renderer does not apply yet (src/render/texture_table.h applies baseColor and
-  // metallicRoughness of gltf_pbr materials and every emissive and normal texture).
+  // metallicRoughness of gltf_pbr materials, every emissive and normal texture, and the
+  // transmission texture of the transmission combination).
   void warnUnrenderedTextures(const Material& m) {
-    if (m.transmissionTexture.present()) notRenderedYet("transmissionTexture");
+    if (m.transmissionTexture.present() && !m.transmissionTextured) notRenderedYet("transmissionTexture");
     if ((m.combined() || m.model != MODEL_GLTF_PBR) &&
         (m.baseColorTexture.present() || m.metallicRoughnessTexture.present()))
       notRenderedYet("baseColorTexture/metallicRoughnessTexture RGB of materials other than a single gltf_pbr "

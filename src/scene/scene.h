@@ -86,6 +86,11 @@ struct Material {
   // KHR_materials_transmission: fraction of light transmitted (R channel of the texture).
   float transmissionFactor = 0.0f;
   TextureRef transmissionTexture;       // linear; R x transmissionFactor
+  // Set by the loader when transmissionTexture applies: the material is KHR_materials_transmission's
+  // combination {gltf_pbr, weight 1 - w; glass, weight w} (w = transmissionFactor x (1 - metallic);
+  // in that order, even for w = 1), and the renderer takes w x R (the texture's R at the hit) for
+  // the glass and 1 - w x R for gltf_pbr (docs/scenes.md, "Transmission").
+  bool transmissionTextured = false;
   // KHR_materials_ior (1.5 without the extension).
   float ior = 1.5f;
   // KHR_materials_volume. hasVolume false, or thicknessFactor 0: a thin-walled surface.
@@ -93,10 +98,18 @@ struct Material {
   float thicknessFactor = 0.0f;
   float attenuationDistance = INFINITY;  // metres; infinity: no absorption
   glm::vec3 attenuationColor{1.0f};      // colour after attenuationDistance, in [0, 1]
+  // The absorption coefficient sigma_a [1/m] per channel inside the material's volume, >= 0 and
+  // finite (shaders/shared/volume.h); zero: none. The loader sets it for a refracting volume
+  // (-ln attenuationColor / attenuationDistance). A ray that meets one of the material's
+  // triangles from its back (against the geometric normal) has travelled inside and is attenuated
+  // by exp(-sigma_a t) over its length t (docs/scenes.md, "Volumes").
+  glm::vec3 absorption{0.0f};
 
   bool combined() const { return !components.empty(); }
   // Emits light (any channel of the emission above zero): the material's triangles are lights.
   bool emits() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
+  // Absorbs inside its volume (any channel of absorption above zero).
+  bool absorbs() const { return absorption.x > 0.0f || absorption.y > 0.0f || absorption.z > 0.0f; }
   // True when a normal map needs tangents at this material's triangles.
   bool normalMapped() const { return normalTexture.present(); }
 };

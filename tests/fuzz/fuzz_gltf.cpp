@@ -68,7 +68,8 @@ void checkInvariants(const nusselt::Scene& s) {
       checkRef(*r);
     if (!std::isfinite(m.normalScale) || !std::isfinite(m.alphaCutoff) || !(m.ior >= 1.0f) || !std::isfinite(m.ior) ||
         !(m.transmissionFactor >= 0.0f && m.transmissionFactor <= 1.0f) || !std::isfinite(m.thicknessFactor) ||
-        !(m.attenuationDistance > 0.0f) || !finite(m.attenuationColor))
+        !(m.attenuationDistance > 0.0f) || !finite(m.attenuationColor) || !finite(m.absorption) ||
+        m.absorption.x < 0 || m.absorption.y < 0 || m.absorption.z < 0)
       finding("bad material factor");
   }
   for (const nusselt::PunctualLight& l : s.lights) {

@@ -10,9 +10,13 @@
 #include <cstring>
 #include <random>
 
+#include "../support/alpha_layers.h"
 #include "../support/test_support.h"
 #include "render/device_scene.h"
+#include "render/material_table.h"
 #include "render/renderer.h"
+#include "render/texture_table.h"
+#include "scene/bvh.h"
 #include "util/error.h"
 
 using namespace nusselt;
@@ -95,12 +99,15 @@ std::vector<Ray> randomRays(const Scene& scene, std::uint32_t n, std::uint32_t s
   return rays;
 }
 
-// Both queries of `module` (trace_tool or trace_tool_rq) on every ray.
-std::vector<Hit> trace(vk::Context& ctx, const DeviceScene& scene, const std::vector<Ray>& rays, const char* module) {
+// Both queries of `module` (trace_tool or trace_tool_rq; with _a the alpha test, which needs the
+// scene's materials and the specialization constants `spec`) on every ray.
+std::vector<Hit> trace(vk::Context& ctx, const DeviceScene& scene, const std::vector<Ray>& rays, const char* module,
+                       const MaterialTable* materials = nullptr, const std::vector<std::uint32_t>& spec = {}) {
   const std::uint32_t n = static_cast<std::uint32_t>(rays.size());
   StageGlobals globals(ctx, STAGE_PUSH_BYTES);
   Globals& g = globals.host();
   scene.fillGlobals(g);
+  if (materials) materials->fillGlobals(g);
   vk::Buffer origin = vk::createBuffer(ctx, n * 16ull, 0, true, "ray origin");
   vk::Buffer direction = vk::createBuffer(ctx, n * 16ull, 0, true, "ray direction");
   vk::Buffer hit = vk::createBuffer(ctx, n * 16ull, 0, true, "hit");
@@ -119,7 +126,7 @@ std::vector<Hit> trace(vk::Context& ctx, const DeviceScene& scene, const std::ve
   g.pathInfo = info.address;
   g.stats = stats.address;
   globals.upload();
-  vk::ComputePipeline pipe = vk::createComputePipeline(ctx, globals.layout(), module);
+  vk::ComputePipeline pipe = vk::createComputePipeline(ctx, globals.layout(), module, spec);
   VkCommandBuffer cmd = vk::beginOneShot(ctx);
   VkDescriptorSet set = globals.set();
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, globals.layout(), 0, 1, &set, 0, nullptr);
@@ -272,4 +279,72 @@ TEST(Traversal, FallsBackWithoutRayQueries) {
   }
   EXPECT_EQ(ctx.validationMessages.load(), 0u);
   vk::destroyContext(ctx);
+}
+
+// The C++ twin's alpha test (bvhClosestHit with the scene's AlphaTester) against the GPU's
+// (trace_tool_a: the GLSL BVH with HAS_ALPHA, and trace_tool_rq_a with ray queries when the device
+// has them) on tests/support/alpha_layers.h (MASK, BLEND and opaque layers): rays from z = 1 down
+// through the layers, kept 1e-3 away from every triangle edge on each layer (where float rounding
+// may pick another triangle, and BLEND's hash, which takes the triangle index, another answer).
+// Every ray must give the same triangle, and t within 1e-6 relative; the rays must stop on every
+// layer (the MASK's opaque half, the BLEND layer and the opaque one behind it).
+TEST(Traversal, AlphaTestOfTheCppTwinMatchesTheGpu) {
+  vk::Context& ctx = test::context();
+  const Scene scene = test::alphaLayers();
+  TraversalStructures structures;
+  structures.bvh = true;
+  structures.accelerationStructures = ctx.rayQuery;
+  DeviceScene device(ctx, scene, structures);
+  RenderSettings settings;
+  settings.sampler = SamplerKind::Cosine;  // no sampling tables: only the materials and textures matter
+  MaterialTable materials(ctx, scene, settings);
+  const Bvh bvh = buildBvh(scene.positions);  // the same order as the device's (deterministic build)
+  const AlphaTester alpha(scene, bvh.triangleOrder);
+  const BvhHitFilter passes = [&](std::uint32_t tri, float b1, float b2, glm::vec3 o, glm::vec3 d) {
+    return alpha(tri, b1, b2, o, d);
+  };
+  // Away from the quads' edges (a 0.25 grid) and their diagonals (x - x0 = y - y0) on each layer.
+  auto clear = [](glm::vec3 o, glm::vec3 d) {
+    for (float z : {0.0f, -1.0f, -2.0f}) {
+      const glm::vec3 p = o + d * ((z - o.z) / d.z);
+      const float fx = p.x / 0.25f - std::floor(p.x / 0.25f), fy = p.y / 0.25f - std::floor(p.y / 0.25f);
+      if (std::min({fx, 1 - fx, fy, 1 - fy}) * 0.25f < 1e-3f || std::fabs(fx - fy) * 0.25f < 1e-3f) return false;
+    }
+    return true;
+  };
+  std::mt19937 rng(43);
+  std::uniform_real_distribution<float> u(-0.8f, 0.8f), tilt(-0.05f, 0.05f);
+  std::vector<Ray> rays;
+  while (rays.size() < 20000) {
+    const glm::vec3 o(u(rng), u(rng), 1.0f);
+    const glm::vec3 d = glm::normalize(glm::vec3(tilt(rng), tilt(rng), -1.0f));
+    if (clear(o, d)) rays.push_back({o, d, 3.0e38f});
+  }
+  // Constants 7, 8, 9 (stage_common.glsl): no environment, textures, alpha.
+  const std::vector<std::uint32_t> spec{0, 0, 0, 0, 0, 0, 0, 0u, 1u, 1u};
+  std::vector<const char*> modules{"trace_tool_a"};
+  if (ctx.rayQuery) modules.push_back("trace_tool_rq_a");
+  for (const char* module : modules) {
+    const std::vector<Hit> gpu = trace(ctx, device, rays, module, &materials, spec);
+    std::uint32_t layerHits[3] = {0, 0, 0}, differ = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      float t = 0;
+      std::uint32_t tri = INVALID_INDEX;
+      const bool hit = bvhClosestHit(bvh, scene.positions, rays[i].o, rays[i].d, 0.0f, rays[i].tmax, t, tri, passes);
+      const Hit& h = gpu[i];
+      if (hit != h.closest || (hit && (tri != h.tri || std::fabs(t - h.t) > 1e-6f * t)) || h.any != h.closest) {
+        if (++differ <= 10)
+          ADD_FAILURE() << module << " ray " << i << ": C++ " << (hit ? "triangle " + std::to_string(tri) : "miss")
+                        << " at t " << t << ", GPU " << (h.closest ? "triangle " + std::to_string(h.tri) : "miss")
+                        << " at t " << h.t << (h.any != h.closest ? " (any-hit disagrees)" : "");
+        continue;
+      }
+      if (hit) ++layerHits[scene.triangleMaterial[bvh.triangleOrder[tri]]];
+    }
+    std::printf("%s: %zu rays; MASK %u, BLEND %u, opaque %u hits; %u differ\n", module, rays.size(), layerHits[0],
+                layerHits[1], layerHits[2], differ);
+    EXPECT_EQ(differ, 0u) << module;
+    for (std::uint32_t n : layerHits) EXPECT_GT(n, rays.size() / 20) << module;
+  }
+  EXPECT_EQ(test::validationMessages(), 0u);
 }

@@ -8,7 +8,11 @@
 #include <random>
 #include <vector>
 
+#include "../../shaders/shared/alpha.h"
+#include "render/texture_table.h"
 #include "scene/bvh.h"
+#include "scene/scene.h"
+#include "../support/alpha_layers.h"
 
 namespace nusselt {
 namespace {
@@ -430,6 +434,63 @@ TEST(Bvh, BuildTimes) {
                 bvh.stats.seconds, bvh.stats.nodes, bvh.stats.leaves, bvh.stats.maxDepth, bvh.stats.maxLeafSize,
                 bvh.stats.sahCost);
   }
+}
+
+
+// The twin with the scene's AlphaTester (the GPU rule, shared/alpha.h) against brute force with
+// the same filter, on rays from z = 1 down through the layers (slightly tilted, so that BLEND's hash
+// sees varied rays): both find the same triangle; where the texture's alpha is 1 (x < 0 at
+// z = 0) every ray stops on the MASK layer, where it is 0 none does; of the rays through the mask,
+// the BLEND layer stops a fraction that a binomial z-test (significance 0.001) holds at 0.3, and
+// the others reach the opaque layer. Without the filter every ray stops at z = 0 (the old twin).
+TEST(Bvh, ClosestHitAppliesAlphaAsTheGpuDoes) {
+  const Scene s = test::alphaLayers();
+  const Bvh bvh = buildBvh(s.positions);
+  const AlphaTester alpha(s, bvh.triangleOrder);
+  const BvhHitFilter passes = [&](std::uint32_t tri, float b1, float b2, glm::vec3 o, glm::vec3 d) {
+    return alpha(tri, b1, b2, o, d);
+  };
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<float> u(-0.8f, 0.8f), tilt(-0.05f, 0.05f);
+  int through = 0, blendStops = 0;
+  const int n = 4000;
+  for (int k = 0; k < n; ++k) {
+    glm::vec3 o(u(rng), u(rng), 1.0f);
+    if (std::fabs(o.x) < 0.1f) continue;  // keep the tilted rays on one side of the mask's edge
+    const glm::vec3 d = glm::normalize(glm::vec3(tilt(rng), tilt(rng), -1.0f));
+    float t = 0;
+    std::uint32_t tri = 0;
+    ASSERT_TRUE(bvhClosestHit(bvh, s.positions, o, d, 0.0f, kInf, t, tri, passes)) << o.x << " " << o.y << " " << d.x << " " << d.y;
+    // Brute force over the reordered triangles with the same filter.
+    float tb = kInf;
+    std::uint32_t ib = INVALID_INDEX;
+    for (std::uint32_t i = 0; i < bvh.triangleOrder.size(); ++i) {
+      const std::uint32_t q = bvh.triangleOrder[i];
+      float tt, b1, b2;
+      if (intersectTriangle(o, d, s.positions[3 * q], s.positions[3 * q + 1] - s.positions[3 * q],
+                            s.positions[3 * q + 2] - s.positions[3 * q], 0.0f, tb, tt, b1, b2) &&
+          passes(i, b1, b2, o, d)) {
+        tb = tt;
+        ib = i;
+      }
+    }
+    ASSERT_EQ(tri, ib) << "ray " << k;
+    const std::uint32_t layer = s.triangleMaterial[bvh.triangleOrder[tri]];
+    if (o.x < 0) {
+      EXPECT_EQ(layer, 0u) << "ray " << k;
+    } else {
+      EXPECT_NE(layer, 0u) << "ray " << k;
+      ++through;
+      if (layer == 1) ++blendStops;
+    }
+    float t0 = 0;
+    std::uint32_t tri0 = 0;
+    ASSERT_TRUE(bvhClosestHit(bvh, s.positions, o, d, 0.0f, kInf, t0, tri0));
+    EXPECT_EQ(s.triangleMaterial[bvh.triangleOrder[tri0]], 0u);
+  }
+  ASSERT_GT(through, 1000);
+  const double p = 0.3, z = (blendStops - p * through) / std::sqrt(through * p * (1 - p));
+  EXPECT_LT(std::fabs(z), 3.29) << blendStops << " of " << through << " rays stopped on the BLEND layer";
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../../shaders/shared/brdf/dispatch.h"
+#include "../../shaders/shared/volume.h"
 #include "io/image_decode.h"
 #include "scene/gltf_loader.h"
 #include "scene/tangents.h"
@@ -478,7 +479,10 @@ TEST(GltfTextures, AlphaSidednessTransmissionIorVolume) {
   EXPECT_FLOAT_EQ(m.thicknessFactor, 0.02f);
   EXPECT_FLOAT_EQ(m.attenuationDistance, 0.5f);
   EXPECT_FLOAT_EQ(m.attenuationColor.y, 0.5f);
-  EXPECT_TRUE(hasWarning(s, "read but not rendered yet: KHR_materials_volume attenuation, transmissionTexture ("));
+  // A metal (glTF's default metallicFactor 1) does not transmit: no path gets inside to be attenuated.
+  EXPECT_TRUE(hasWarning(s, "read but not rendered yet: KHR_materials_volume attenuation without thicknessFactor > 0 "
+                            "and transmission, transmissionTexture ("));
+  EXPECT_EQ(m.absorption, glm::vec3(0.0f));
   // glTF's default metallicFactor 1: a metal does not transmit, the material stays gltf_pbr.
   EXPECT_EQ(m.model, MODEL_GLTF_PBR);
   EXPECT_FALSE(m.combined());
@@ -506,7 +510,7 @@ TEST(GltfTextures, AlphaSidednessTransmissionIorVolume) {
   EXPECT_HAS(errorWith(R"({"extensions": {"KHR_materials_ior": {"ior": 0.5}}})"),
              "materials[0] KHR_materials_ior.ior: 0.5 is not in [1, 100]");
   EXPECT_HAS(errorWith(R"({"extensions": {"KHR_materials_volume": {"attenuationDistance": 0}}})"),
-             "KHR_materials_volume.attenuationDistance: 0 is not > 0");
+             "mem.gltf: materials[0] KHR_materials_volume.attenuationDistance: 0 is not a distance >= 1e-30 (metres)");
   EXPECT_HAS(errorWith(R"({"extensions": {"KHR_materials_volume": {"attenuationColor": [1, 2, 0]}}})"),
              "KHR_materials_volume.attenuationColor[1]: 2 is not in [0, 1]");
   EXPECT_HAS(errorWith(R"({"extensions": {"KHR_materials_transmission": {"transmissionTexture": {"index": 9}}}})"),
@@ -553,6 +557,87 @@ TEST(GltfTextures, TransmissionBecomesTheDielectric) {
     EXPECT_EQ(t.components[1].model, MODEL_THIN_DIELECTRIC) << volume;
     EXPECT_FLOAT_EQ(t.components[1].params.v[THIN_DIELECTRIC_ETA / 4][THIN_DIELECTRIC_ETA % 4], 1.7f);
   }
+}
+
+// transmissionTexture applies to the transmission combination: the material stays combined
+// {gltf_pbr, 1 - w; glass, w} even for w = 1, marked transmissionTextured (the renderer takes
+// w x R for the glass); without transmission (w = 0: a metal) it is named as not rendered.
+TEST(GltfTextures, TransmissionTextureKeepsTheCombination) {
+  Json j = texturedQuad();
+  j["extensionsUsed"] = {"KHR_materials_transmission"};
+  j["materials"][0] = Json::parse(R"({"name": "stained", "pbrMetallicRoughness": {"metallicFactor": 0},
+    "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"index": 0}}}})");
+  Scene s = loadJson(j);
+  const Material& m = s.materials[0];
+  ASSERT_EQ(m.components.size(), 2u);
+  EXPECT_TRUE(m.transmissionTextured);
+  EXPECT_EQ(m.components[0].model, MODEL_GLTF_PBR);
+  EXPECT_FLOAT_EQ(m.components[0].weight, 0.0f);
+  EXPECT_EQ(m.components[1].model, MODEL_THIN_DIELECTRIC);
+  EXPECT_FLOAT_EQ(m.components[1].weight, 1.0f);
+  EXPECT_FALSE(hasWarning(s, "transmissionTexture"));
+  j["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 1;
+  Scene metal = loadJson(j);
+  EXPECT_FALSE(metal.materials[0].transmissionTextured);
+  EXPECT_FALSE(metal.materials[0].combined());
+  EXPECT_TRUE(hasWarning(metal, "read but not rendered yet: transmissionTexture ("));
+}
+
+// KHR_materials_volume's attenuation in a refracting volume (thicknessFactor > 0, transmission):
+// Material::absorption = -ln(attenuationColor) / attenuationDistance per channel (volume.h), a
+// colour channel of 0 clamped to VOLUME_MAX_ABSORPTION, no attenuationDistance (or one beyond
+// 1e30) none; not named in the "not rendered" warning. Bad values are errors naming the file, the
+// material and the field.
+TEST(GltfTextures, VolumeAttenuationBecomesTheAbsorptionCoefficient) {
+  Json j = texturedQuad();
+  j["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_volume"};
+  auto glass = [&](const std::string& volume) {
+    j["materials"][0] = Json::parse(R"({"name": "tinted", "pbrMetallicRoughness": {"metallicFactor": 0},
+      "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+                     "KHR_materials_volume": )" + volume + "}}");
+    return j;
+  };
+  Scene s = loadJson(glass(R"({"thicknessFactor": 0.1, "attenuationDistance": 0.5, "attenuationColor": [1, 0.5, 0.1]})"));
+  const Material& m = s.materials[0];
+  EXPECT_EQ(m.model, MODEL_DIELECTRIC);
+  EXPECT_FLOAT_EQ(m.absorption.x, 0.0f);
+  EXPECT_NEAR(m.absorption.y, std::log(2.0) / 0.5, 1e-5);
+  EXPECT_NEAR(m.absorption.z, std::log(10.0) / 0.5, 1e-5);
+  EXPECT_TRUE(m.absorbs());
+  EXPECT_FALSE(hasWarning(s, "read but not rendered yet"));
+  // The transmittance over attenuationDistance is attenuationColor.
+  const glm::vec3 t = shared::volumeTransmittance(m.absorption, 0.5f);
+  EXPECT_NEAR(t.y, 0.5f, 1e-6);
+  EXPECT_NEAR(t.z, 0.1f, 1e-6);
+  // A black channel absorbs everything, finitely; no distance (or 1e300): no absorption.
+  const Material black = loadJson(glass(R"({"thicknessFactor": 0.1, "attenuationDistance": 2, "attenuationColor": [0, 1, 1]})")).materials[0];
+  EXPECT_EQ(black.absorption.x, VOLUME_MAX_ABSORPTION);
+  EXPECT_EQ(shared::volumeTransmittance(black.absorption, 1e-6f).x, 0.0f);
+  EXPECT_EQ(shared::volumeTransmittance(black.absorption, 0.0f).x, 1.0f);
+  for (const char* none : {R"({"thicknessFactor": 0.1, "attenuationColor": [0.5, 0.5, 0.5]})",
+                           R"({"thicknessFactor": 0.1, "attenuationColor": [0, 0, 0]})",
+                           R"({"thicknessFactor": 0.1, "attenuationDistance": 1e300, "attenuationColor": [0.5, 0.5, 0.5]})"}) {
+    const Material n = loadJson(glass(none)).materials[0];
+    EXPECT_FALSE(n.absorbs()) << none;
+  }
+  // Thin-walled (thickness 0): nothing travels inside; the attenuation is named as not rendered.
+  Scene thin = loadJson(glass(R"({"attenuationDistance": 0.5, "attenuationColor": [1, 0.5, 0.1]})"));
+  EXPECT_FALSE(thin.materials[0].absorbs());
+  EXPECT_TRUE(hasWarning(thin, "KHR_materials_volume attenuation without thicknessFactor > 0 and transmission"));
+  // Bad values.
+  const std::string f = "mem.gltf: materials[0] \"tinted\" KHR_materials_volume.";
+  EXPECT_HAS(jsonError(glass(R"({"thicknessFactor": 0.1, "attenuationDistance": -1})")),
+             f + "attenuationDistance: -1 is not a distance >= 1e-30 (metres)");
+  EXPECT_HAS(jsonError(glass(R"({"thicknessFactor": 0.1, "attenuationDistance": 0})")),
+             f + "attenuationDistance: 0 is not a distance >= 1e-30");
+  EXPECT_HAS(jsonError(glass(R"({"thicknessFactor": 0.1, "attenuationDistance": 1e-40})")),
+             f + "attenuationDistance: 1e-40 is not a distance >= 1e-30");
+  EXPECT_HAS(jsonError(glass(R"({"attenuationDistance": "far"})")), f + "attenuationDistance: must be a number");
+  EXPECT_HAS(jsonError(glass(R"({"attenuationColor": [0.5, -0.1, 0]})")), f + "attenuationColor[1]: -0.1 is not in [0, 1]");
+  EXPECT_HAS(jsonError(glass(R"({"attenuationColor": [0.5, 0.5, 1.5]})")), f + "attenuationColor[2]: 1.5 is not in [0, 1]");
+  EXPECT_HAS(jsonError(glass(R"({"attenuationColor": [0.5, 0.5]})")), f + "attenuationColor: expected 3 numbers");
+  EXPECT_HAS(jsonError(glass(R"({"attenuationColor": [0.5, "red", 0.5]})")), f + "attenuationColor: expected 3 numbers");
+  // (JSON has no NaN or infinity; the checks above reject them too: !(d >= 1e-30), !(0 <= c <= 1).)
 }
 
 TEST(GltfTextures, ImageSourcesBufferViewDataUriAndExternalFile) {

@@ -1,0 +1,80 @@
+// mlt.h: primary-sample-space Metropolis (PSSMLT; Kelemen, Szirmay-Kalos et al. 2002; issue 19,
+// docs/mlt.md): the chains' state (GpuMlt, the buffers of src/render/mlt_integrator.cpp) and the
+// mutation kernel, shared by the mlt stage (shaders/stages/mlt.comp) and its C++ tests.
+//
+// A chain's state is a primary sample vector: the 2-D draws of a path (stage_common.glsl,
+// pathSample2), which the path tracer turns into a path and its radiance L. Each step proposes a
+// new vector, either a large step (every draw fresh and uniform: an independent path) with
+// probability largeStep, or a small step (every coordinate moved by a normal deviate of standard
+// deviation sigma, wrapped around the unit interval). Both proposals are symmetric, q(x -> y) =
+// q(y -> x) (a large step's density is 1 either way; a small step's depends only on the wrapped
+// difference, whose distribution is symmetric about 0), so the acceptance is
+// min(1, f(y) / f(x)) with f = luminance(L).
+#ifndef NUSSELT_MLT_H
+#define NUSSELT_MLT_H
+#include "prelude.h"
+#include "rng.h"
+SHARED_BEGIN
+
+// The kernels of the mlt stage (specialization constant 13 of shaders/stages/mlt.comp).
+#define MLT_KERNEL_POOL 0u     // path slot c gets the vector of bootstrap path poolFirst + c
+#define MLT_KERNEL_START 1u    // path slot c gets the vector of bootstrap path start[c] (chain c's start)
+#define MLT_KERNEL_RECORD 2u   // pool[poolFirst + c] = f of the path slot c traced
+#define MLT_KERNEL_ADOPT 3u    // chain c's state = the path slot c traced (its start), no splat
+#define MLT_KERNEL_MUTATE 4u   // path slot c gets chain c's proposal
+#define MLT_KERNEL_ACCEPT 5u   // splat current and proposal, accept or reject
+#define MLT_KERNEL_RESOLVE 6u  // the pass's splats into the film
+// Splats are sums of fixed-point integers (2^24 units per unit of luminance-normalised radiance),
+// 64 bits per channel (two uints with carry): integer addition commutes, so the image does not
+// depend on the order in which chains splat (same seed, same image, bit for bit).
+#define MLT_FIXED_SCALE 16777216.0f
+// Counters (GpuMlt.counters): proposals, accepted, large-step proposals, large steps accepted.
+#define MLT_COUNTERS 4u
+// The draws of a step that are not a coordinate (large or small, accept): dimension index.
+#define MLT_DIM_STEP 0xffffffffu
+// Streams of the hash (the fourth key component): chains' mutations, the bootstrap pool, chain starts.
+#define MLT_STREAM_MUTATE 0x6d75u
+#define MLT_STREAM_POOL 0x706fu
+#define MLT_STREAM_START 0x7374u
+
+// The chains' state: GpuMlt (layout.h, Globals.mlt).
+
+SHARED_FN float mltUnit(uint bits) { return float(bits >> 8u) * (1.0f / 16777216.0f); }
+
+// The hash of one step's draws: chain, iteration, dimension (or MLT_DIM_STEP), seed.
+SHARED_FN uvec4 mltHash(uint chain, uint iteration, uint dimension, uint seed) {
+  return pcg4d(uvec4(chain, iteration, dimension, seed ^ (MLT_STREAM_MUTATE << 16u)));
+}
+
+// Bootstrap path i's vector, draw `dimension`: independent uniforms (24 bits, never 1).
+SHARED_FN vec2 mltPoolSample(uint i, uint dimension, uint seed) {
+  uvec4 h = pcg4d(uvec4(i, dimension, seed, MLT_STREAM_POOL));
+  return vec2(mltUnit(h.x), mltUnit(h.y));
+}
+
+// x wrapped into [0, 1) (x - floor(x) rounds to 1 for tiny negative x: that is 0 on the circle).
+SHARED_FN float mltWrap(float x) {
+  x = x - floor(x);
+  return x < 1.0f ? x : 0.0f;
+}
+
+// The small step of draw u: both coordinates plus sigma x a standard normal pair (Box-Muller on
+// h.x, h.y), wrapped. The displacement's law is that of sigma N(0, I) wrapped on the torus,
+// whatever u: symmetric.
+SHARED_FN vec2 mltSmallStep(vec2 u, uvec4 h, float sigma) {
+  float u1 = (float(h.x >> 8u) + 1.0f) * (1.0f / 16777216.0f);  // (0, 1]: log finite
+  float a = 6.28318530717958647692f * mltUnit(h.y);
+  float r = sigma * sqrt(-2.0f * log(u1));
+  return vec2(mltWrap(u.x + r * cos(a)), mltWrap(u.y + r * sin(a)));
+}
+
+// The large step's draw: fresh uniforms from h.z, h.w.
+SHARED_FN vec2 mltLargeStep(uvec4 h) { return vec2(mltUnit(h.z), mltUnit(h.w)); }
+
+// The proposal for draw u of a step (large or small) with that draw's hash h.
+SHARED_FN vec2 mltPropose(vec2 u, uvec4 h, bool large, float sigma) {
+  return large ? mltLargeStep(h) : mltSmallStep(u, h, sigma);
+}
+
+SHARED_END
+#endif

@@ -1,0 +1,107 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// mlt: the kernels of primary-sample-space Metropolis (docs/mlt.md, src/render/mlt_integrator.cpp),
+// one per pipeline (constant 13, MLT_KERNEL_*), around the path tracer's stages, which trace the
+// vectors these kernels put into the path slots (g.primarySamples) and leave each slot's radiance
+// in g.pathRadiance and its pixel in g.pathInfo.x. One invocation per chain (or bootstrap path, or
+// pixel for the resolve). Vectors are stored as the path tracer reads them (layout.h,
+// primarySampleIndex).
+#include "shared/stage_common.glsl"
+#include "shared/mlt.h"
+
+layout(constant_id = 13) const uint MLT_KERNEL = 0u;
+
+// A path's radiance, or 0 (counted) when it is not finite: f = 0 is never accepted nor splatted.
+vec3 tracedRadiance(uint c) {
+  vec3 L = g.pathRadiance.v[c].xyz;
+  if (!(isFinite(L.x) && isFinite(L.y) && isFinite(L.z))) {
+    atomicAdd(g.stats.v[STAT_NONFINITE_SAMPLES], 1u);
+    return vec3(0.0f);
+  }
+  return max(L, vec3(0.0f));
+}
+
+// Adds v (>= 0, < 2^8 per channel) to a pixel's fixed-point sums: a 64-bit integer per channel
+// as two uints, the carry of the low word added to the high word.
+void splat(GpuMlt m, uint pixel, vec3 v) {
+  for (uint ch = 0u; ch < 3u; ++ch) {
+    float x = min(v[ch], 255.0f);
+    uint hi = uint(floor(x * (1.0f / 256.0f)));           // units of 2^32 / MLT_FIXED_SCALE = 256
+    float rest = x - float(hi) * 256.0f;
+    uint lo = uint(min(rest * MLT_FIXED_SCALE + 0.5f, 4294967040.0f));
+    uint at = (pixel * 3u + ch) * 2u;
+    uint old = atomicAdd(m.splats.v[at], lo);
+    uint carry = old + lo < old ? 1u : 0u;
+    if (hi + carry != 0u) atomicAdd(m.splats.v[at + 1u], hi + carry);
+  }
+}
+
+// Adds n subgroup-wide to counter k (one atomic per subgroup).
+void count(GpuMlt m, uint k, bool on) {
+  uint n = subgroupBallotBitCount(subgroupBallot(on));
+  if (subgroupElect() && n != 0u) atomicAdd(m.counters.v[k], n);
+}
+
+void main() {
+  uint c = gl_GlobalInvocationID.x;
+  GpuMlt m = g.mlt.v[0];
+  uint chains = m.info.x;
+  uint dims = m.info.y;
+  uint iteration = m.info.z;
+  Vec2s primary = g.primarySamples;
+
+  if (MLT_KERNEL == MLT_KERNEL_POOL || MLT_KERNEL == MLT_KERNEL_START) {
+    if (c >= (MLT_KERNEL == MLT_KERNEL_POOL ? m.pool.y : chains)) return;
+    uint i = MLT_KERNEL == MLT_KERNEL_POOL ? m.pool.x + c : m.start.v[c];
+    for (uint d = 0u; d < dims; ++d) primary.v[primarySampleIndex(c, d, dims)] = mltPoolSample(i, d, g.seed);
+  } else if (MLT_KERNEL == MLT_KERNEL_RECORD) {
+    if (c >= m.pool.y) return;
+    m.poolF.v[m.pool.x + c] = luminance(tracedRadiance(c));
+  } else if (MLT_KERNEL == MLT_KERNEL_ADOPT) {
+    if (c >= chains) return;
+    for (uint d = 0u; d < dims; ++d) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];
+    m.state.v[c] = vec4(tracedRadiance(c), uintBitsToFloat(g.pathInfo.v[c].x));
+  } else if (MLT_KERNEL == MLT_KERNEL_MUTATE) {
+    if (c >= chains) return;
+    bool large = mltUnit(mltHash(c, iteration, MLT_DIM_STEP, g.seed).x) < m.params.x;
+    for (uint d = 0u; d < dims; ++d)
+      primary.v[primarySampleIndex(c, d, dims)] =
+          mltPropose(m.current.v[primarySampleIndex(c, d, dims)], mltHash(c, iteration, d, g.seed), large, m.params.y);
+  } else if (MLT_KERNEL == MLT_KERNEL_ACCEPT) {
+    bool live = c < chains;
+    bool large = false, accepted = false;
+    if (live) {
+      uvec4 h = mltHash(c, iteration, MLT_DIM_STEP, g.seed);
+      large = mltUnit(h.x) < m.params.x;
+      vec4 state = m.state.v[c];
+      vec3 Lc = state.xyz;
+      float fc = luminance(Lc);
+      vec3 Lp = tracedRadiance(c);
+      float fp = luminance(Lp);
+      uint pp = g.pathInfo.v[c].x;
+      float a = fc > 0.0f ? min(1.0f, fp / fc) : 1.0f;
+      // Expected values: the proposal weighted by its acceptance, the current state by the rest.
+      if (fp > 0.0f && a > 0.0f) splat(m, pp, Lp * (a / fp));
+      if (fc > 0.0f && a < 1.0f) splat(m, floatBitsToUint(state.w), Lc * ((1.0f - a) / fc));
+      accepted = mltUnit(h.y) < a;
+      if (accepted) {
+        for (uint d = 0u; d < dims; ++d) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];
+        m.state.v[c] = vec4(Lp, uintBitsToFloat(pp));
+      }
+    }
+    count(m, 0u, live);
+    count(m, 1u, accepted);
+    count(m, 2u, live && large);
+    count(m, 3u, accepted && large);
+  } else if (MLT_KERNEL == MLT_KERNEL_RESOLVE) {
+    if (c >= m.info.w) return;
+    vec3 sum;
+    for (uint ch = 0u; ch < 3u; ++ch) {
+      uint at = (c * 3u + ch) * 2u;
+      sum[ch] = float(m.splats.v[at + 1u]) * 4294967296.0f + float(m.splats.v[at]);
+      m.splats.v[at] = 0u;
+      m.splats.v[at + 1u] = 0u;
+    }
+    g.film.v[c] += vec4(sum * m.params.z, m.params.w);
+  }
+}

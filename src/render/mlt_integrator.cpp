@@ -1,0 +1,225 @@
+// mlt_integrator.cpp: the chains' buffers, the bootstrap and the Metropolis steps (mlt_integrator.h).
+#include "render/mlt_integrator.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+
+#include "../../shaders/shared/layout.h"
+#include "../../shaders/shared/mlt.h"
+#include "util/error.h"
+
+namespace nusselt {
+
+using shared::GpuMlt;
+using shared::Globals;
+
+std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t dims, std::uint32_t bootstrap,
+                                      std::uint64_t pixels) {
+  // Current vectors, states, start indices; splat sums; the bootstrap's f values; GpuMlt, counters.
+  return std::uint64_t(shared::primarySampleSlots(chains)) * dims * 8ull + std::uint64_t(chains) * 20 + pixels * 24 +
+         std::uint64_t(bootstrap) * 4 + 256;
+}
+
+std::uint32_t MltIntegrator::iterationsPerPassFor(const RenderSettings& s) {
+  if (s.samplesPerPass) return s.samplesPerPass;
+  return std::max<std::uint32_t>(1, (1u << 18) / std::max<std::uint32_t>(s.mltChains, 1));
+}
+
+MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
+                             std::unique_ptr<PathIntegrator> paths, std::uint64_t pixels)
+    : m_ctx(ctx), m_globals(globals), m_settings(settings), m_paths(std::move(paths)), m_pixels(pixels) {
+  m_chains = m_paths->capacity();
+  m_dims = globals.host().primaryDims;
+  if (m_dims == 0 || m_chains == 0) throw Error("mlt: the path tracer has no primary samples");
+  m_poolSize = mltBootstrapPaths(settings);
+  m_report.chains = m_chains;
+  m_report.dims = m_dims;
+  m_report.bootstrapPaths = m_poolSize;
+  m_buffers.reserve(8);
+  auto make = [&](VkDeviceSize bytes, const std::string& what, bool host = false) -> vk::Buffer* {
+    m_buffers.push_back(vk::createBuffer(m_ctx, bytes, 0, host, what));
+    return &m_buffers.back();
+  };
+  m_mlt = make(sizeof(GpuMlt), "mlt state", true);
+  vk::Buffer* current = make(std::uint64_t(shared::primarySampleSlots(m_chains)) * m_dims * 8, "mlt current vectors");
+  vk::Buffer* state = make(std::uint64_t(m_chains) * 16, "mlt chain states");
+  m_splats = make(m_pixels * 24, "mlt splats");
+  m_poolF = make(std::uint64_t(m_poolSize) * 4, "mlt bootstrap");
+  m_start = make(std::uint64_t(m_chains) * 4, "mlt chain starts");
+  m_counters = make(MLT_COUNTERS * 4, "mlt counters", true);
+  std::memset(m_counters->mapped, 0, MLT_COUNTERS * 4);
+  GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
+  m = GpuMlt{};
+  m.info = {m_chains, m_dims, 0u, static_cast<std::uint32_t>(m_pixels)};
+  m.pool = {0u, 0u, m_poolSize, 0u};
+  m.params = {settings.mltLargeStep, settings.mltSigma, 0.0f, 0.0f};
+  m.current = current->address;
+  m.state = state->address;
+  m.splats = m_splats->address;
+  m.poolF = m_poolF->address;
+  m.start = m_start->address;
+  m.counters = m_counters->address;
+  globals.host().mlt = m_mlt->address;
+
+  VkCommandBuffer cmd = vk::beginOneShot(m_ctx);
+  vkCmdFillBuffer(cmd, m_splats->buffer, 0, VK_WHOLE_SIZE, 0);
+  vk::endOneShot(m_ctx, cmd);
+
+  for (std::uint32_t k = 0; k <= MLT_KERNEL_RESOLVE; ++k) {
+    std::vector<std::uint32_t> spec(14, 0u);
+    spec[13] = k;  // constant 13: MLT_KERNEL
+    m_kernels.push_back(vk::createComputePipeline(m_ctx, globals.layout(), "mlt", spec));
+  }
+  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  ai.commandPool = m_ctx.commandPool;
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  VK_CHECK(vkAllocateCommandBuffers(m_ctx.device, &ai, &m_cmd));
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VK_CHECK(vkCreateFence(m_ctx.device, &fci, nullptr, &m_fence));
+}
+
+MltIntegrator::~MltIntegrator() {
+  VkDevice d = m_ctx.device;
+  vkDeviceWaitIdle(d);
+  if (m_fence) vkDestroyFence(d, m_fence, nullptr);
+  if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
+  for (auto& p : m_kernels) vk::destroyComputePipeline(m_ctx, p);
+  for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
+}
+
+std::uint64_t MltIntegrator::deviceBytes() const {
+  std::uint64_t total = m_paths->deviceBytes();
+  for (const vk::Buffer& b : m_buffers) total += b.size;
+  return total;
+}
+
+VkCommandBuffer MltIntegrator::begin() {
+  VK_CHECK(vkResetCommandBuffer(m_cmd, 0));
+  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_CHECK(vkBeginCommandBuffer(m_cmd, &bi));
+  const VkDescriptorSet set = m_globals.set();
+  vkCmdBindDescriptorSets(m_cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_globals.layout(), 0, 1, &set, 0, nullptr);
+  return m_cmd;
+}
+
+void MltIntegrator::submit(VkCommandBuffer cmd) {
+  VK_CHECK(vkEndCommandBuffer(cmd));
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd;
+  VK_CHECK(vkResetFences(m_ctx.device, 1, &m_fence));
+  VK_CHECK(vkQueueSubmit(m_ctx.queue, 1, &si, m_fence));
+  VK_CHECK(vkWaitForFences(m_ctx.device, 1, &m_fence, VK_TRUE, UINT64_MAX));
+  m_paths->foldStats();
+}
+
+void MltIntegrator::dispatch(VkCommandBuffer cmd, std::uint32_t kernel, std::uint32_t n) {
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_kernels[kernel].pipeline);
+  vkCmdDispatch(cmd, (n + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE, 1, 1);
+  vk::computeBarrier(cmd);
+}
+
+void MltIntegrator::bootstrap() {
+  auto t0 = std::chrono::steady_clock::now();
+  Globals& g = m_globals.host();
+  GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
+  g.chunkFirst = 0;
+  g.passSamples = 1;
+  g.sampleIndex = 0;
+  // The pool, a chunk of at most `chains` paths at a time.
+  for (std::uint32_t first = 0; first < m_poolSize; first += m_chains) {
+    const std::uint32_t count = std::min(m_chains, m_poolSize - first);
+    m.pool.x = first;
+    m.pool.y = count;
+    g.chunkPaths = count;
+    m_globals.upload();
+    VkCommandBuffer cmd = begin();
+    dispatch(cmd, MLT_KERNEL_POOL, count);
+    m_paths->recordTrace(cmd, count);
+    vk::computeBarrier(cmd);
+    dispatch(cmd, MLT_KERNEL_RECORD, count);
+    submit(cmd);
+  }
+  std::vector<float>& f = m_poolValues;
+  f.resize(m_poolSize);
+  vk::downloadBuffer(m_ctx, *m_poolF, f.data(), std::uint64_t(m_poolSize) * 4);
+  // b and the cumulative sums in double, in pool order (deterministic).
+  std::vector<double> cdf(m_poolSize + 1, 0.0);
+  for (std::uint32_t i = 0; i < m_poolSize; ++i) {
+    const double fi = std::max(0.0, double(f[i]));
+    m_report.nonzeroBootstrap += fi > 0 ? 1 : 0;
+    cdf[i + 1] = cdf[i] + fi;
+  }
+  const double total = cdf[m_poolSize];
+  m_report.b = total / double(m_poolSize);
+  if (total > 0) {
+    // Chain c starts at the pool path whose cdf interval holds a uniform number of 48 bits from a
+    // hash of (c, seed): the start is drawn in proportion to f_i, independently per chain.
+    std::vector<std::uint32_t> start(m_chains);
+    for (std::uint32_t c = 0; c < m_chains; ++c) {
+      const glm::uvec4 h = shared::pcg4d(glm::uvec4(c, m_settings.seed, MLT_STREAM_START, 0x9e3779b9u));
+      const double u = (double(h.x >> 8) * 16777216.0 + double(h.y >> 8)) / 281474976710656.0;
+      const double target = u * total;
+      auto it = std::upper_bound(cdf.begin() + 1, cdf.end(), target);
+      std::uint32_t i = static_cast<std::uint32_t>(std::min<std::ptrdiff_t>(it - cdf.begin() - 1, m_poolSize - 1));
+      while (i > 0 && f[i] <= 0.0f) --i;  // a zero-width interval is never chosen (u < 1 guards the end)
+      start[c] = i;
+    }
+    vk::uploadBuffer(m_ctx, *m_start, start.data(), std::uint64_t(m_chains) * 4);
+    g.chunkPaths = m_chains;
+    m_globals.upload();
+    VkCommandBuffer cmd = begin();
+    dispatch(cmd, MLT_KERNEL_START, m_chains);
+    m_paths->recordTrace(cmd, m_chains);
+    vk::computeBarrier(cmd);
+    dispatch(cmd, MLT_KERNEL_ADOPT, m_chains);
+    submit(cmd);
+  }
+  // Film value of a splat sum: b x pixels / chains per unit, per iteration (the film divides by
+  // its count, the iterations).
+  m.params.z = static_cast<float>(m_report.b * double(m_pixels) / double(m_chains) / double(MLT_FIXED_SCALE));
+  m_bootstrapped = true;
+  m_report.bootstrapSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void MltIntegrator::readCounters() {
+  std::uint32_t* c = static_cast<std::uint32_t*>(m_counters->mapped);
+  m_report.proposals += c[0];
+  m_report.accepted += c[1];
+  m_report.largeProposals += c[2];
+  m_report.largeAccepted += c[3];
+  std::memset(c, 0, MLT_COUNTERS * 4);
+}
+
+void MltIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples) {
+  if (!m_bootstrapped) bootstrap();
+  Globals& g = m_globals.host();
+  GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
+  g.chunkFirst = 0;
+  g.chunkPaths = m_chains;
+  g.passSamples = 1;
+  if (m_report.b > 0) {
+    for (std::uint32_t k = 0; k < samples; ++k) {
+      g.sampleIndex = sampleIndex + k;
+      m.info.z = sampleIndex + k;  // keys the step's random numbers
+      m_globals.upload();
+      VkCommandBuffer cmd = begin();
+      dispatch(cmd, MLT_KERNEL_MUTATE, m_chains);
+      m_paths->recordTrace(cmd, m_chains);
+      vk::computeBarrier(cmd);
+      dispatch(cmd, MLT_KERNEL_ACCEPT, m_chains);
+      submit(cmd);
+      readCounters();
+    }
+  }
+  // The pass's splats into the film; every pixel counts `samples` iterations.
+  m.params.w = float(samples);
+  VkCommandBuffer cmd = begin();
+  dispatch(cmd, MLT_KERNEL_RESOLVE, static_cast<std::uint32_t>(m_pixels));
+  submit(cmd);
+}
+
+}  // namespace nusselt

@@ -1,0 +1,97 @@
+// mlt_integrator.h: primary-sample-space Metropolis light transport (PSSMLT; Kelemen,
+// Szirmay-Kalos et al. 2002; issue 19, docs/mlt.md) on the GPU, a sibling of the path tracer that
+// drives it: the path tracer (PathIntegrator with primary samples and image samples) turns each
+// chain's proposed primary sample vector into a path, radiance L and pixel; the mlt stage
+// (shaders/stages/mlt.comp) mutates, accepts and splats.
+//
+//   bootstrap (once): B independent paths (vectors hashed from their index), f_i = luminance(L_i);
+//     b = mean f_i (the normalisation: the integral of f over primary sample space); each chain
+//     starts at pool path i chosen with probability f_i / sum f (on the host, from a hash of the
+//     chain index and the seed), re-traced from its vector (a path is a function of it).
+//   step (per iteration, all chains at once): propose (large step with probability p, else small
+//     step), trace, splat the proposal with weight a and the current state with 1 - a (a =
+//     min(1, f(y) / f(x))), each as L / f, into 64-bit fixed-point sums; accept with probability a.
+//   resolve (per pass): film += (b x pixels / chains) x splats, count += iterations.
+//
+// The estimate is unbiased for any chain length: the start is drawn from the pool in proportion
+// to f with b from the same pool, so E[b h(X_0)] = E[(1/B) sum_i f_i h(x_i)] = integral of f h,
+// and each step preserves it (f-invariance of the kernel). Direct light stays in the chain (the
+// whole path contribution is the chain's f): one estimator, no second pass.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "render/integrator.h"
+#include "render/path_integrator.h"
+
+namespace nusselt {
+
+struct MltReport {
+  std::uint64_t proposals = 0, accepted = 0, largeProposals = 0, largeAccepted = 0;
+  double b = 0;                 // the normalisation: mean luminance of the bootstrap paths
+  std::uint32_t chains = 0, bootstrapPaths = 0, dims = 0;
+  std::uint64_t nonzeroBootstrap = 0;  // bootstrap paths with f > 0
+  double bootstrapSeconds = 0;  // wall time of the bootstrap (its paths, b, the chains' starts)
+  double acceptance() const { return proposals ? double(accepted) / double(proposals) : 0.0; }
+};
+
+class MltIntegrator : public Integrator {
+ public:
+  // paths: the path tracer, created with PathOptions{primaryDimsFor(maxDepth), imageSamples,
+  // capacity = settings.mltChains}.
+  MltIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
+                std::unique_ptr<PathIntegrator> paths, std::uint64_t pixels);
+  ~MltIntegrator() override;
+
+  // Device bytes of the chains' state beyond the path tracer's.
+  static std::uint64_t bytesFor(std::uint32_t chains, std::uint32_t dims, std::uint32_t bootstrap, std::uint64_t pixels);
+  // Mutations per chain per pass when RenderSettings::samplesPerPass is 0: about 2^18 paths per
+  // pass (the path tracer's count on a CPU device: a time budget ends within a few seconds on
+  // lavapipe), at least 1.
+  static std::uint32_t iterationsPerPassFor(const RenderSettings& settings);
+
+  // `samples` iterations (one mutation of every chain each), iterations sampleIndex ..
+  // sampleIndex + samples - 1; the bootstrap runs before the first.
+  void renderPass(std::uint32_t sampleIndex, std::uint32_t samples) override;
+  RenderStats stats() const override { return m_paths->stats(); }
+  void addStats(const RenderStats& carried) override { m_paths->addStats(carried); }
+  const std::vector<std::pair<std::string, double>>& stageSeconds() const override { return m_paths->stageSeconds(); }
+  const std::vector<std::uint64_t>& raysPerBounce() const override { return m_paths->raysPerBounce(); }
+  std::uint64_t deviceBytes() const override;
+  PathIntegrator& paths() { return *m_paths; }
+  const MltReport& report() const { return m_report; }
+  // f (luminance of L) of every bootstrap path, in pool order (after the first pass; tests).
+  const std::vector<float>& bootstrapValues() const { return m_poolValues; }
+
+ private:
+  void bootstrap();
+  // Records kernel k over n invocations (and a barrier).
+  void dispatch(VkCommandBuffer cmd, std::uint32_t kernel, std::uint32_t n);
+  VkCommandBuffer begin();
+  void submit(VkCommandBuffer cmd);
+  void readCounters();
+
+  vk::Context& m_ctx;
+  StageGlobals& m_globals;
+  RenderSettings m_settings;
+  std::unique_ptr<PathIntegrator> m_paths;
+  std::uint64_t m_pixels = 0;
+  std::uint32_t m_chains = 0, m_dims = 0, m_poolSize = 0;
+  bool m_bootstrapped = false;
+  MltReport m_report;
+  std::vector<float> m_poolValues;
+  std::vector<vk::Buffer> m_buffers;
+  vk::Buffer* m_mlt = nullptr;  // the GpuMlt (host visible)
+  vk::Buffer* m_poolF = nullptr;
+  vk::Buffer* m_start = nullptr;
+  vk::Buffer* m_counters = nullptr;
+  vk::Buffer* m_splats = nullptr;
+  std::vector<vk::ComputePipeline> m_kernels;  // by MLT_KERNEL_*
+  VkCommandBuffer m_cmd = VK_NULL_HANDLE;
+  VkFence m_fence = VK_NULL_HANDLE;
+};
+
+}  // namespace nusselt

@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# --integrator: path is the default and leaves the header as before (no nusselt/integratorName);
+# an unknown name and the combinations Metropolis renders do not support are refused with a
+# message that says why, a failure status and no output file.
+# Usage: integrator.sh NUSSELT SOURCE_DIR
+set -u
+nusselt=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fails=0
+fail() { echo "FAIL $*"; fails=$((fails + 1)); }
+small=(--width 8 --height 8 --spp 1 -q --checkpoint 0)
+
+# expect_error NAME EXPECTED_TEXT -- ARGS...
+expect_error() {
+  local name=$1 expected=$2; shift 3
+  "$nusselt" render -o "$work/$name.exr" "${small[@]}" "$@" >"$work/out" 2>"$work/err"
+  local status=$?
+  if [ $status -eq 0 ] || [ $status -ge 128 ]; then fail "$name: exit status $status"; return; fi
+  if [ -e "$work/$name.exr" ]; then fail "$name: wrote an image"; return; fi
+  grep -qF -- "$expected" "$work/err" || { fail "$name: message lacks '$expected': $(cat "$work/err")"; return; }
+  echo "ok   $name: $(cat "$work/err")"
+}
+
+"$nusselt" render -o "$work/path.exr" "${small[@]}" || fail "default render"
+"$nusselt" render -o "$work/path2.exr" "${small[@]}" --integrator path || fail "--integrator path"
+line=$("$nusselt" diff "$work/path2.exr" "$work/path.exr")
+[[ "$line" == *"max |diff| 0" ]] || fail "--integrator path differs from the default: $line"
+if "$nusselt" info "$work/path.exr" | grep -q "integratorName"; then fail "a path render's header names its integrator"; fi
+
+expect_error unknown "unknown integrator" -- --integrator bdpt
+expect_error mlt_resume "cannot be resumed" -- --integrator mlt --resume "$work/path.exr" --spp 2
+expect_error mlt_guiding "not supported" -- --integrator mlt --guiding on
+expect_error mlt_variance "no per-sample variance" -- --integrator mlt --variance
+
+# An mlt render: its header names it; merging it is refused; resuming it with path is refused.
+"$nusselt" render -o "$work/mlt.exr" "${small[@]}" --integrator mlt --mlt-chains 1024 --spp 2 || fail "mlt render"
+[ "$("$nusselt" info "$work/mlt.exr" | sed -n 's/^  nusselt\/integratorName: //p')" = mlt ] || fail "mlt header"
+"$nusselt" render -o "$work/mlt2.exr" "${small[@]}" --integrator mlt --mlt-chains 1024 --spp 2 --spp-offset 2 || fail "mlt render 2"
+if "$nusselt" merge "$work/mlt.exr" "$work/mlt2.exr" -o "$work/merged.exr" 2>"$work/err"; then fail "merge of mlt renders"
+elif ! grep -qF "merging Metropolis renders is not supported" "$work/err"; then fail "merge message: $(cat "$work/err")"
+else echo "ok   mlt_merge: $(cat "$work/err")"; fi
+cp "$work/mlt.exr" "$work/resume.exr"
+if "$nusselt" render "${small[@]}" --resume "$work/resume.exr" --spp 4 2>"$work/err"; then fail "path resume of an mlt render"
+elif ! grep -qF "integrator" "$work/err"; then fail "resume message: $(cat "$work/err")"
+else echo "ok   mlt_resume_as_path: $(cat "$work/err")"; fi
+
+[ $fails -eq 0 ] && echo "all integrator checks passed"
+exit $((fails > 0))

@@ -1,0 +1,175 @@
+// Metropolis (--integrator mlt, docs/mlt.md) against the path tracer on the Cornell box: the same
+// image in expectation for short and long chains (no start-up bias), the same image for the
+// same seed bit for bit, and the large-step acceptance the integrand predicts.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "../support/test_support.h"
+#include "cli/cli_common.h"
+#include "render/mlt_integrator.h"
+
+using namespace nusselt;
+
+namespace {
+
+Scene cornell() { return loadSceneOrDefault("", ""); }
+
+RenderSettings base(std::uint32_t seed) {
+  RenderSettings s;
+  s.width = 16;
+  s.height = 16;
+  s.maxDepth = 5;
+  s.seed = seed;
+  return s;
+}
+
+RenderSettings mltSettings(std::uint32_t seed, std::uint32_t chains, std::uint32_t iterations) {
+  RenderSettings s = base(seed);
+  s.integrator = IntegratorKind::Mlt;
+  s.mltChains = chains;
+  s.spp = iterations;
+  return s;
+}
+
+constexpr int kBlock = 4;  // blocks of 4 x 4 pixels: 16 blocks of the 16 x 16 image
+
+// Mean luminance of every block (and its variance of the mean from the per-pixel variances, for
+// the path tracer's independent pixels), then the whole image last.
+void blockMeans(const Image& img, std::vector<double>& mean, std::vector<double>* var) {
+  const int bw = img.width / kBlock, bh = img.height / kBlock, blocks = bw * bh;
+  mean.assign(blocks + 1, 0.0);
+  if (var) var->assign(blocks + 1, 0.0);
+  const double w[3] = {0.2126, 0.7152, 0.0722};
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const std::size_t p = std::size_t(y) * img.width + x;
+      const int b = (y / kBlock) * bw + x / kBlock;
+      for (int c = 0; c < 3; ++c) {
+        mean[b] += w[c] * img.rgb[3 * p + c] / (kBlock * kBlock);
+        mean[blocks] += w[c] * img.rgb[3 * p + c] / (img.width * img.height);
+      }
+      // Channels of one pixel are correlated: the luminance's variance is bounded by (sum w sd)^2.
+      if (var) {
+        double sd = 0;
+        for (int c = 0; c < 3; ++c) sd += w[c] * std::sqrt(std::max(0.0f, img.variance[3 * p + c]));
+        (*var)[b] += sd * sd / double(kBlock * kBlock * kBlock * kBlock);
+        (*var)[blocks] += sd * sd / (double(img.width) * img.height * img.width * img.height);
+      }
+    }
+}
+
+// Upper tail P(T > t) of Student's t with nu degrees of freedom (Simpson's rule on t = tan theta).
+double studentTail(double t, double nu) {
+  const double c = std::exp(std::lgamma(0.5 * (nu + 1)) - std::lgamma(0.5 * nu)) / std::sqrt(nu * M_PI);
+  const double a = std::atan(t), b = 0.5 * M_PI;
+  const int n = 20000;
+  auto f = [&](double th) {
+    if (th >= b) return 0.0;
+    const double x = std::tan(th), s = 1.0 / std::cos(th);
+    return c * std::pow(1 + x * x / nu, -0.5 * (nu + 1)) * s * s;
+  };
+  double sum = f(a) + f(b);
+  for (int i = 1; i < n; ++i) sum += f(a + (b - a) * i / n) * (i % 2 ? 4 : 2);
+  return sum * (b - a) / (3 * n);
+}
+
+// Mean of `seeds` Metropolis renders against a path-traced reference, per block and for the
+// whole image: Welch-style t with the seeds' sample variance (the only honest variance of a
+// correlated estimate) plus the reference's; each test two-sided at 0.001 / tests (Bonferroni).
+// The bootstrap's pool is large (2^17 paths): its estimate of b carries most of a short render's
+// variance (a 2 % error with the default 4 x 4096 paths), which would hide a bias of that size.
+void expectMltMatchesPath(std::uint32_t chains, std::uint32_t iterations, int seeds) {
+  Scene scene = cornell();
+  RenderSettings ps = base(1000);
+  ps.spp = 8192;
+  test::Rendered ref = test::render(scene, ps);
+  std::vector<double> refMean, refVar;
+  blockMeans(ref.image, refMean, &refVar);
+  const std::size_t tests = refMean.size();
+  std::vector<double> sum(tests, 0.0), sumSq(tests, 0.0);
+  for (int k = 0; k < seeds; ++k) {
+    RenderSettings ms = mltSettings(10 + k, chains, iterations);
+    ms.mltBootstrap = 1u << 17;
+    test::Rendered r = test::render(scene, ms);
+    EXPECT_EQ(r.stats.nonFiniteSamples, 0u);
+    std::vector<double> m;
+    blockMeans(r.image, m, nullptr);
+    for (std::size_t b = 0; b < tests; ++b) sum[b] += m[b], sumSq[b] += m[b] * m[b];
+  }
+  const double alpha = 0.001 / double(tests), n = seeds;
+  for (std::size_t b = 0; b < tests; ++b) {
+    const double mean = sum[b] / n, s2 = std::max(0.0, (sumSq[b] - n * mean * mean) / (n - 1));
+    const double t = (mean - refMean[b]) / std::sqrt(s2 / n + refVar[b]);
+    const double p = 2 * studentTail(std::abs(t), n - 1);
+    if (b + 1 == tests)
+      std::printf("%u chains x %u mutations, %d seeds: image luminance mlt %.5f +- %.5f, path %.5f +- %.5f (t %.2f)\n",
+                  chains, iterations, seeds, mean, std::sqrt(s2 / n), refMean[b], std::sqrt(refVar[b]), t);
+    EXPECT_GT(p, alpha) << (b + 1 == tests ? std::string("image") : "block " + std::to_string(b)) << ": mlt "
+                        << mean << " +- " << std::sqrt(s2 / n) << " vs path " << refMean[b] << " +- "
+                        << std::sqrt(refVar[b]) << " (t " << t << ", " << chains << " chains x " << iterations
+                        << " mutations)";
+  }
+}
+
+}  // namespace
+
+TEST(Mlt, StudentTailIsRight) {
+  // Known quantiles: t(7) upper 0.025 at 2.3646, t(5) upper 0.0005 at 6.8688.
+  EXPECT_NEAR(studentTail(2.3646, 7), 0.025, 1e-4);
+  EXPECT_NEAR(studentTail(6.8688, 5), 0.0005, 1e-5);
+}
+
+// Chains of 10 mutations: what is left of start-up bias would show here.
+TEST(Mlt, ShortChainsMatchThePathTracer) { expectMltMatchesPath(4096, 10, 10); }
+
+// Chains of 1000 mutations: the chains' stationary law.
+TEST(Mlt, LongChainsMatchThePathTracer) { expectMltMatchesPath(512, 1000, 6); }
+
+TEST(Mlt, SameSeedIsBitIdenticalOtherSeedIsNot) {
+  Scene scene = cornell();
+  test::Rendered a = test::render(scene, mltSettings(5, 1024, 8));
+  test::Rendered b = test::render(scene, mltSettings(5, 1024, 8));
+  ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
+  EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
+  test::Rendered c = test::render(scene, mltSettings(6, 1024, 8));
+  EXPECT_NE(0, std::memcmp(a.image.rgb.data(), c.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// With large steps only, one step of every chain is an independence proposal y (a fresh path)
+// from the chain's start x (pool path i, chosen with probability f_i / F): given the pool, the
+// accepted count is Binomial(chains, p) with p = (1 / F) sum_i E_y min(f_i, f(y)). The pool's own
+// values estimate E_y (a sample of independent paths like y): p^ = (1 / (F B)) sum_i sum_j
+// min(f_i, f_j), with variance Var(h(y)) / B, h(y) = (1 / F) sum_i min(f_i, f(y)). z-test at a
+// two-sided 0.001.
+TEST(Mlt, LargeStepAcceptanceIsWhatTheIntegrandPredicts) {
+  Scene scene = cornell();
+  RenderSettings s = mltSettings(21, 16384, 1);
+  s.mltLargeStep = 1.0f;
+  Renderer r(test::context(), scene, s);
+  r.render(1);
+  const MltReport& rep = r.mlt()->report();
+  ASSERT_EQ(rep.proposals, 16384u);
+  ASSERT_EQ(rep.largeProposals, rep.proposals);
+  std::vector<double> v(r.mlt()->bootstrapValues().begin(), r.mlt()->bootstrapValues().end());
+  std::sort(v.begin(), v.end());
+  const double B = double(v.size());
+  double F = 0;
+  for (double x : v) F += x;
+  ASSERT_GT(F, 0.0);
+  // h at every pool value: sum over f_i < v of f_i, plus v for every f_i >= v (sorted prefix sums).
+  double below = 0, sumH = 0, sumH2 = 0;
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    const double h = (below + v[k] * (B - double(k))) / F;
+    sumH += h, sumH2 += h * h;
+    below += v[k];
+  }
+  const double p = sumH / B, varH = (sumH2 - B * p * p) / (B - 1);
+  const double observed = double(rep.accepted) / double(rep.proposals);
+  const double z = (observed - p) / std::sqrt(p * (1 - p) / double(rep.proposals) + varH / B);
+  EXPECT_LT(std::abs(z), 3.29) << "large-step acceptance " << observed << ", predicted " << p;
+  std::printf("large-step acceptance %.4f, predicted %.4f (z %.2f)\n", observed, p, z);
+}
