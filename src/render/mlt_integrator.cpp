@@ -136,12 +136,7 @@ void MltIntegrator::bootstrap() {
     m.pool.y = count;
     g.chunkPaths = count;
     m_globals.upload();
-    VkCommandBuffer cmd = begin();
-    dispatch(cmd, MLT_KERNEL_POOL, count);
-    m_paths->recordTrace(cmd, count);
-    vk::computeBarrier(cmd);
-    dispatch(cmd, MLT_KERNEL_RECORD, count);
-    submit(cmd);
+    traceBetween(MLT_KERNEL_POOL, MLT_KERNEL_RECORD, count);
   }
   std::vector<float>& f = m_poolValues;
   f.resize(m_poolSize);
@@ -171,18 +166,22 @@ void MltIntegrator::bootstrap() {
     vk::uploadBuffer(m_ctx, *m_start, start.data(), std::uint64_t(m_chains) * 4);
     g.chunkPaths = m_chains;
     m_globals.upload();
-    VkCommandBuffer cmd = begin();
-    dispatch(cmd, MLT_KERNEL_START, m_chains);
-    m_paths->recordTrace(cmd, m_chains);
-    vk::computeBarrier(cmd);
-    dispatch(cmd, MLT_KERNEL_ADOPT, m_chains);
-    submit(cmd);
+    traceBetween(MLT_KERNEL_START, MLT_KERNEL_ADOPT, m_chains);
   }
   // Film value of a splat sum: b x pixels / chains per unit, per iteration (the film divides by
   // its count, the iterations).
   m.params.z = static_cast<float>(m_report.b * double(m_pixels) / double(m_chains) / double(MLT_FIXED_SCALE));
   m_bootstrapped = true;
   m_report.bootstrapSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void MltIntegrator::traceBetween(std::uint32_t before, std::uint32_t after, std::uint32_t n) {
+  VkCommandBuffer cmd = begin();
+  dispatch(cmd, before, n);
+  m_paths->recordTrace(cmd, n);
+  vk::computeBarrier(cmd);
+  dispatch(cmd, after, n);
+  submit(cmd);
 }
 
 void MltIntegrator::readCounters() {
@@ -206,12 +205,7 @@ void MltIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples)
       g.sampleIndex = sampleIndex + k;
       m.info.z = sampleIndex + k;  // keys the step's random numbers
       m_globals.upload();
-      VkCommandBuffer cmd = begin();
-      dispatch(cmd, MLT_KERNEL_MUTATE, m_chains);
-      m_paths->recordTrace(cmd, m_chains);
-      vk::computeBarrier(cmd);
-      dispatch(cmd, MLT_KERNEL_ACCEPT, m_chains);
-      submit(cmd);
+      traceBetween(MLT_KERNEL_MUTATE, MLT_KERNEL_ACCEPT, m_chains);
       readCounters();
     }
   }

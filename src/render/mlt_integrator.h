@@ -72,6 +72,9 @@ class MltIntegrator : public Integrator {
   void dispatch(VkCommandBuffer cmd, std::uint32_t kernel, std::uint32_t n);
   VkCommandBuffer begin();
   void submit(VkCommandBuffer cmd);
+  // One submission: kernel `before` over n chains, the path tracer's trace of their paths, then
+  // kernel `after` (the pool, the chains' starts, every step).
+  void traceBetween(std::uint32_t before, std::uint32_t after, std::uint32_t n);
   void readCounters();
 
   vk::Context& m_ctx;

@@ -199,6 +199,25 @@ ThirdsContrast floorThirdsContrast(const test::Rendered& r) {
   return c;
 }
 
+// Orthographic camera looking down at the quads of addTexturedQuad at theta from the normal.
+void obliqueCamera(Scene& s, double theta) {
+  s.hasCamera = true;
+  s.camera.orthographic = true;
+  s.camera.forward = glm::vec3(float(std::sin(theta)), 0.0f, float(-std::cos(theta)));
+  s.camera.position = -3.0f * s.camera.forward;
+  s.camera.up = glm::vec3(0, 1, 0);
+  s.camera.xmag = s.camera.ymag = 0.5f;
+}
+
+// Unpolarised Fresnel reflectance of an interface of relative index eta at incidence theta, from
+// the s and p amplitudes; cosT: the cosine of the refracted angle.
+double fresnelUnpolarised(double theta, double eta, double* cosT = nullptr) {
+  const double ci = std::cos(theta), ct = std::sqrt(1 - std::pow(std::sin(theta) / eta, 2));
+  const double rs2 = std::pow((ci - eta * ct) / (ci + eta * ct), 2), rp2 = std::pow((eta * ci - ct) / (eta * ci + ct), 2);
+  if (cosT) *cosT = ct;
+  return 0.5 * (rs2 + rp2);
+}
+
 }  // namespace
 
 // A 2 x 2 sRGB emissive texture on a quad filling a 16 x 16 orthographic view, max depth 0
@@ -598,20 +617,13 @@ TEST(TexturesRender, ThinSheetTransmitsStraightThrough) {
   addTexturedQuad(s, 0.3f, 0, 6.0f);
   addTexturedQuad(s, 0.0f, 1, 6.0f);
   const double theta = M_PI / 3, eta = 1.5;
-  s.hasCamera = true;
-  s.camera.orthographic = true;
-  s.camera.forward = glm::vec3(float(std::sin(theta)), 0.0f, float(-std::cos(theta)));
-  s.camera.position = -3.0f * s.camera.forward;
-  s.camera.up = glm::vec3(0, 1, 0);
-  s.camera.xmag = s.camera.ymag = 0.5f;
+  obliqueCamera(s, theta);
   RenderSettings rs;
   rs.width = rs.height = 16;
   rs.spp = 64;
   rs.maxDepth = 8;
   rs.seed = 19;
-  const double ci = std::cos(theta), ct = std::sqrt(1 - std::pow(std::sin(theta) / eta, 2));
-  const double rs2 = std::pow((ci - eta * ct) / (ci + eta * ct), 2), rp2 = std::pow((eta * ci - ct) / (eta * ci + ct), 2);
-  const double R1 = 0.5 * (rs2 + rp2);
+  const double R1 = fresnelUnpolarised(theta, eta);
   expectImageMean(test::render(s, rs), (1 - R1) / (1 + R1));
 }
 
@@ -636,20 +648,14 @@ TEST(TexturesRender, AbsorbingSlabTransmitsFresnelTimesBeerLambert) {
   addTexturedQuad(s, 0.4f, 0, 6.0f);
   addTexturedQuad(s, 0.2f, 0, 6.0f, true);
   addTexturedQuad(s, 0.0f, 1, 6.0f);
-  s.hasCamera = true;
-  s.camera.orthographic = true;
-  s.camera.forward = glm::vec3(float(std::sin(theta)), 0.0f, float(-std::cos(theta)));
-  s.camera.position = -3.0f * s.camera.forward;
-  s.camera.up = glm::vec3(0, 1, 0);
-  s.camera.xmag = s.camera.ymag = 0.5f;
+  obliqueCamera(s, theta);
   RenderSettings rs;
   rs.width = rs.height = 16;
   rs.spp = 64;
   rs.maxDepth = 12;
   rs.seed = 23;
-  const double ci = std::cos(theta), ct = std::sqrt(1 - std::pow(std::sin(theta) / eta, 2));
-  const double rs2 = std::pow((ci - eta * ct) / (ci + eta * ct), 2), rp2 = std::pow((eta * ci - ct) / (eta * ci + ct), 2);
-  const double R = 0.5 * (rs2 + rp2);
+  double ct;
+  const double R = fresnelUnpolarised(theta, eta, &ct);
   glm::dvec3 expected;
   for (int k = 0; k < 3; ++k) {
     const double tau = std::exp(-sigma[k] * d / ct);
