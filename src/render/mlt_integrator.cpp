@@ -71,20 +71,13 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
     spec[13] = k;  // constant 13: MLT_KERNEL
     m_kernels.push_back(vk::createComputePipeline(m_ctx, globals.layout(), "mlt", spec));
   }
-  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  ai.commandPool = m_ctx.commandPool;
-  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  ai.commandBufferCount = 1;
-  VK_CHECK(vkAllocateCommandBuffers(m_ctx.device, &ai, &m_cmd));
-  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  VK_CHECK(vkCreateFence(m_ctx.device, &fci, nullptr, &m_fence));
+  m_recorder = vk::createRecorder(m_ctx);
 }
 
 MltIntegrator::~MltIntegrator() {
   VkDevice d = m_ctx.device;
   vkDeviceWaitIdle(d);
-  if (m_fence) vkDestroyFence(d, m_fence, nullptr);
-  if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
+  vk::destroyRecorder(m_ctx, m_recorder);
   for (auto& p : m_kernels) vk::destroyComputePipeline(m_ctx, p);
   for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
 }
@@ -96,23 +89,14 @@ std::uint64_t MltIntegrator::deviceBytes() const {
 }
 
 VkCommandBuffer MltIntegrator::begin() {
-  VK_CHECK(vkResetCommandBuffer(m_cmd, 0));
-  VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  VK_CHECK(vkBeginCommandBuffer(m_cmd, &bi));
+  VkCommandBuffer cmd = vk::beginRecording(m_ctx, m_recorder);
   const VkDescriptorSet set = m_globals.set();
-  vkCmdBindDescriptorSets(m_cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_globals.layout(), 0, 1, &set, 0, nullptr);
-  return m_cmd;
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_globals.layout(), 0, 1, &set, 0, nullptr);
+  return cmd;
 }
 
-void MltIntegrator::submit(VkCommandBuffer cmd) {
-  VK_CHECK(vkEndCommandBuffer(cmd));
-  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  si.commandBufferCount = 1;
-  si.pCommandBuffers = &cmd;
-  VK_CHECK(vkResetFences(m_ctx.device, 1, &m_fence));
-  VK_CHECK(vkQueueSubmit(m_ctx.queue, 1, &si, m_fence));
-  VK_CHECK(vkWaitForFences(m_ctx.device, 1, &m_fence, VK_TRUE, UINT64_MAX));
+void MltIntegrator::submit() {
+  vk::submitAndWait(m_ctx, m_recorder);
   m_paths->foldStats();
 }
 
@@ -181,7 +165,7 @@ void MltIntegrator::traceBetween(std::uint32_t before, std::uint32_t after, std:
   m_paths->recordTrace(cmd, n);
   vk::computeBarrier(cmd);
   dispatch(cmd, after, n);
-  submit(cmd);
+  submit();
 }
 
 void MltIntegrator::readCounters() {
@@ -213,7 +197,7 @@ void MltIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples)
   m.params.w = float(samples);
   VkCommandBuffer cmd = begin();
   dispatch(cmd, MLT_KERNEL_RESOLVE, static_cast<std::uint32_t>(m_pixels));
-  submit(cmd);
+  submit();
 }
 
 }  // namespace nusselt

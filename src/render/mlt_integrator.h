@@ -71,7 +71,7 @@ class MltIntegrator : public Integrator {
   // Records kernel k over n invocations (and a barrier).
   void dispatch(VkCommandBuffer cmd, std::uint32_t kernel, std::uint32_t n);
   VkCommandBuffer begin();
-  void submit(VkCommandBuffer cmd);
+  void submit();
   // One submission: kernel `before` over n chains, the path tracer's trace of their paths, then
   // kernel `after` (the pool, the chains' starts, every step).
   void traceBetween(std::uint32_t before, std::uint32_t after, std::uint32_t n);
@@ -93,8 +93,7 @@ class MltIntegrator : public Integrator {
   vk::Buffer* m_counters = nullptr;
   vk::Buffer* m_splats = nullptr;
   std::vector<vk::ComputePipeline> m_kernels;  // by MLT_KERNEL_*
-  VkCommandBuffer m_cmd = VK_NULL_HANDLE;
-  VkFence m_fence = VK_NULL_HANDLE;
+  vk::Recorder m_recorder;
 };
 
 }  // namespace nusselt

@@ -98,13 +98,7 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   createPipelines();
   m_pipelineSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  ai.commandPool = m_ctx.commandPool;
-  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  ai.commandBufferCount = 1;
-  VK_CHECK(vkAllocateCommandBuffers(m_ctx.device, &ai, &m_cmd));
-  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  VK_CHECK(vkCreateFence(m_ctx.device, &fci, nullptr, &m_fence));
+  m_recorder = vk::createRecorder(m_ctx);
   if (settings.timeStages && m_ctx.properties.limits.timestampComputeAndGraphics) {
     m_queryCapacity = 8 + (settings.maxDepth + 1) * (8 + std::uint32_t(m_slotKeys.size()));
     VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
@@ -117,9 +111,8 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
 PathIntegrator::~PathIntegrator() {
   VkDevice d = m_ctx.device;
   vkDeviceWaitIdle(d);
-  if (m_fence) vkDestroyFence(d, m_fence, nullptr);
+  vk::destroyRecorder(m_ctx, m_recorder);
   if (m_queryPool) vkDestroyQueryPool(d, m_queryPool, nullptr);
-  if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
   for (auto* p : {&m_camera, &m_intersect, &m_escape, &m_accumulate})
     if (p->pipeline) vk::destroyComputePipeline(m_ctx, *p);
   for (auto& p : m_shade) vk::destroyComputePipeline(m_ctx, p);
@@ -329,18 +322,8 @@ void PathIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples
     g.passSamples = samples;
     m_globals.upload();
 
-    VK_CHECK(vkResetCommandBuffer(m_cmd, 0));
-    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    VK_CHECK(vkBeginCommandBuffer(m_cmd, &bi));
-    recordPass(m_cmd, count);
-    VK_CHECK(vkEndCommandBuffer(m_cmd));
-    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    si.commandBufferCount = 1;
-    si.pCommandBuffers = &m_cmd;
-    VK_CHECK(vkResetFences(m_ctx.device, 1, &m_fence));
-    VK_CHECK(vkQueueSubmit(m_ctx.queue, 1, &si, m_fence));
-    VK_CHECK(vkWaitForFences(m_ctx.device, 1, &m_fence, VK_TRUE, UINT64_MAX));
+    recordPass(vk::beginRecording(m_ctx, m_recorder), count);
+    vk::submitAndWait(m_ctx, m_recorder);
     if (m_queryPool && !m_marks.empty()) {
       std::uint32_t n = std::min<std::uint32_t>(static_cast<std::uint32_t>(m_marks.size()) + 1, m_queryCapacity);
       std::vector<std::uint64_t> t(n);

@@ -109,8 +109,7 @@ class PathIntegrator : public Integrator {
   PathOptions m_options;
   vk::Buffer* m_primarySamples = nullptr;
   std::vector<vk::ComputePipeline> m_shade;  // one per slot
-  VkCommandBuffer m_cmd = VK_NULL_HANDLE;
-  VkFence m_fence = VK_NULL_HANDLE;
+  vk::Recorder m_recorder;
   VkQueryPool m_queryPool = VK_NULL_HANDLE;
   std::uint32_t m_queryCapacity = 0;
   std::vector<const char*> m_marks;  // stage name of each timestamp after the first

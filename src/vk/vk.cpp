@@ -594,32 +594,82 @@ void destroyAccelerationStructure(Context& ctx, AccelerationStructure& as) {
   as = AccelerationStructure{};
 }
 
-VkCommandBuffer beginOneShot(Context& ctx) {
+namespace {
+
+VkCommandBuffer allocateCommandBuffer(Context& ctx) {
   VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
   ai.commandPool = ctx.commandPool;
   ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   ai.commandBufferCount = 1;
   VkCommandBuffer cmd;
   VK_CHECK(vkAllocateCommandBuffers(ctx.device, &ai, &cmd));
+  return cmd;
+}
+
+void beginCommandBuffer(VkCommandBuffer cmd) {
   VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VK_CHECK(vkBeginCommandBuffer(cmd, &bi));
+}
+
+VkFence createFence(Context& ctx) {
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VkFence fence;
+  VK_CHECK(vkCreateFence(ctx.device, &fci, nullptr, &fence));
+  return fence;
+}
+
+// Ends cmd, submits it with the (unsignalled) fence and waits for it.
+VkResult endSubmitWait(Context& ctx, VkCommandBuffer cmd, VkFence fence) {
+  VkResult r = vkEndCommandBuffer(cmd);
+  if (r != VK_SUCCESS) return r;
+  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  si.commandBufferCount = 1;
+  si.pCommandBuffers = &cmd;
+  r = vkQueueSubmit(ctx.queue, 1, &si, fence);
+  if (r == VK_SUCCESS) r = vkWaitForFences(ctx.device, 1, &fence, VK_TRUE, UINT64_MAX);
+  return r;
+}
+
+}  // namespace
+
+VkCommandBuffer beginOneShot(Context& ctx) {
+  VkCommandBuffer cmd = allocateCommandBuffer(ctx);
+  beginCommandBuffer(cmd);
   return cmd;
 }
 
 void endOneShot(Context& ctx, VkCommandBuffer cmd) {
-  VK_CHECK(vkEndCommandBuffer(cmd));
-  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  VkFence fence;
-  VK_CHECK(vkCreateFence(ctx.device, &fci, nullptr, &fence));
-  VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  si.commandBufferCount = 1;
-  si.pCommandBuffers = &cmd;
-  VkResult r = vkQueueSubmit(ctx.queue, 1, &si, fence);
-  if (r == VK_SUCCESS) r = vkWaitForFences(ctx.device, 1, &fence, VK_TRUE, UINT64_MAX);
+  VkFence fence = createFence(ctx);
+  VkResult r = endSubmitWait(ctx, cmd, fence);
   vkDestroyFence(ctx.device, fence, nullptr);
   vkFreeCommandBuffers(ctx.device, ctx.commandPool, 1, &cmd);
   VK_CHECK(r);
+}
+
+Recorder createRecorder(Context& ctx) {
+  Recorder r;
+  r.cmd = allocateCommandBuffer(ctx);
+  r.fence = createFence(ctx);
+  return r;
+}
+
+void destroyRecorder(Context& ctx, Recorder& recorder) {
+  if (recorder.fence) vkDestroyFence(ctx.device, recorder.fence, nullptr);
+  if (recorder.cmd) vkFreeCommandBuffers(ctx.device, ctx.commandPool, 1, &recorder.cmd);
+  recorder = Recorder();
+}
+
+VkCommandBuffer beginRecording(Context& ctx, Recorder& recorder) {
+  (void)ctx;
+  VK_CHECK(vkResetCommandBuffer(recorder.cmd, 0));
+  beginCommandBuffer(recorder.cmd);
+  return recorder.cmd;
+}
+
+void submitAndWait(Context& ctx, Recorder& recorder) {
+  VK_CHECK(vkResetFences(ctx.device, 1, &recorder.fence));
+  VK_CHECK(endSubmitWait(ctx, recorder.cmd, recorder.fence));
 }
 
 void uploadBuffer(Context& ctx, Buffer& buffer, const void* data, VkDeviceSize bytes, VkDeviceSize offset) {

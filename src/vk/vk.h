@@ -109,9 +109,20 @@ AccelerationStructure buildBottomLevel(Context& ctx, const Buffer& vertices, std
 AccelerationStructure buildTopLevel(Context& ctx, const AccelerationStructure& bottom);
 void destroyAccelerationStructure(Context& ctx, AccelerationStructure& as);
 
-// One-shot command buffer: begin, record in `record`, submit and wait.
+// One-shot command buffer: begin, record, then endOneShot submits, waits and frees it.
 VkCommandBuffer beginOneShot(Context& ctx);
 void endOneShot(Context& ctx, VkCommandBuffer cmd);
+
+// A command buffer and fence kept for repeated record-submit-wait rounds (an integrator's passes):
+// beginRecording resets and begins the buffer, submitAndWait ends it, submits it and waits.
+struct Recorder {
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
+  VkFence fence = VK_NULL_HANDLE;
+};
+Recorder createRecorder(Context& ctx);
+void destroyRecorder(Context& ctx, Recorder& recorder);
+VkCommandBuffer beginRecording(Context& ctx, Recorder& recorder);
+void submitAndWait(Context& ctx, Recorder& recorder);
 
 // The SPIR-V of a stage embedded at build time, by name (e.g. "shade"). Throws if unknown.
 std::vector<std::uint32_t> embeddedShader(const std::string& name);
