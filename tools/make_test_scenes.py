@@ -419,43 +419,35 @@ def textures():
     b.write("textures.gltf")
 
 
-def glass_slab():
+def slab_scene(material, volume, filename):
+    """A lamp at z = 0 seen through a slab of `material` between z = 0.2 and 0.4 (its
+    KHR_materials_volume: `volume`)."""
     b = Builder()
     b.use("KHR_materials_transmission")
     b.use("KHR_materials_ior")
     b.use("KHR_materials_volume")
-    # The volume's thickness makes the slab refract (without it glTF's transmission is thin-walled).
-    glass = b.pbr_material("glass", {"metallicFactor": 0.0, "roughnessFactor": 0.0},
+    glass = b.pbr_material(material, {"metallicFactor": 0.0, "roughnessFactor": 0.0},
                            extensions={"KHR_materials_transmission": {"transmissionFactor": 1.0},
                                        "KHR_materials_ior": {"ior": 1.5},
-                                       "KHR_materials_volume": {"thicknessFactor": 0.2}})
+                                       "KHR_materials_volume": volume})
     lamp = b.material("lamp", 0.0, emission=(1.0, 1.0, 1.0))
     b.quad("lamp", [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], lamp)
     b.quad("top", [[-1, -1, 0.4], [1, -1, 0.4], [1, 1, 0.4], [-1, 1, 0.4]], glass)
     b.quad("bottom", [[-1, -1, 0.2], [-1, 1, 0.2], [1, 1, 0.2], [1, -1, 0.2]], glass)
     b.camera("camera", (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), 0.3, 1.0)
-    b.write("glass_slab.gltf")
+    b.write(filename)
+
+
+def glass_slab():
+    # The volume's thickness makes the slab refract (without it glTF's transmission is thin-walled).
+    slab_scene("glass", {"thicknessFactor": 0.2}, "glass_slab.gltf")
 
 
 def glass_slab_tinted():
-    b = Builder()
-    b.use("KHR_materials_transmission")
-    b.use("KHR_materials_ior")
-    b.use("KHR_materials_volume")
     # attenuationDistance = the slab's thickness: at normal incidence one crossing transmits
     # attenuationColor.
-    glass = b.pbr_material("tinted", {"metallicFactor": 0.0, "roughnessFactor": 0.0},
-                           extensions={"KHR_materials_transmission": {"transmissionFactor": 1.0},
-                                       "KHR_materials_ior": {"ior": 1.5},
-                                       "KHR_materials_volume": {"thicknessFactor": 0.2,
-                                                                "attenuationDistance": 0.2,
-                                                                "attenuationColor": [0.8, 0.5, 0.2]}})
-    lamp = b.material("lamp", 0.0, emission=(1.0, 1.0, 1.0))
-    b.quad("lamp", [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], lamp)
-    b.quad("top", [[-1, -1, 0.4], [1, -1, 0.4], [1, 1, 0.4], [-1, 1, 0.4]], glass)
-    b.quad("bottom", [[-1, -1, 0.2], [-1, 1, 0.2], [1, 1, 0.2], [1, -1, 0.2]], glass)
-    b.camera("camera", (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), 0.3, 1.0)
-    b.write("glass_slab_tinted.gltf")
+    slab_scene("tinted", {"thicknessFactor": 0.2, "attenuationDistance": 0.2,
+                          "attenuationColor": [0.8, 0.5, 0.2]}, "glass_slab_tinted.gltf")
 
 
 def guiding_gap():
