@@ -25,8 +25,17 @@ void vegasRefine(std::vector<double>& G, float* cdf, std::uint32_t bins, const d
     const double p = (double(cdf[b + 1]) - double(cdf[b])) * double(bins);  // the pass's density in bin b
     G[b] += p * S[b] / n;
   }
+  // Classic VEGAS's smoothing: each bin's estimate averaged with its neighbours' (one bin's
+  // noise, a firefly's F^2, spreads over three), then the square root.
+  std::vector<double> q(bins);
   double mean = 0;
-  for (std::uint32_t b = 0; b < bins; ++b) mean += std::sqrt(G[b]);
+  for (std::uint32_t b = 0; b < bins; ++b) {
+    const std::uint32_t lo = b > 0 ? b - 1 : b, hi = b + 1 < bins ? b + 1 : b;
+    double sum = 0;
+    for (std::uint32_t c = lo; c <= hi; ++c) sum += G[c];
+    q[b] = std::sqrt(sum / double(hi - lo + 1));
+    mean += q[b];
+  }
   mean /= double(bins);
   if (!(mean > 0) || !std::isfinite(mean)) {
     vegasUniformCdf(cdf, bins);
@@ -36,7 +45,7 @@ void vegasRefine(std::vector<double>& G, float* cdf, std::uint32_t bins, const d
   double acc = 0;
   cdf[0] = 0.0f;
   for (std::uint32_t b = 0; b < bins; ++b) {
-    const double p = (1.0 - alpha) * std::sqrt(G[b]) / mean + alpha;
+    const double p = (1.0 - alpha) * q[b] / mean + alpha;
     acc += p / double(bins);
     cdf[b + 1] = static_cast<float>(acc);
   }
