@@ -327,8 +327,8 @@ int mergeCommand(const std::vector<std::string>& inputs, const std::string& outp
     if (r.settings.integrator == IntegratorKind::Mlt)
       throw Error(inputs[k] + ": rendered with --integrator mlt; merging Metropolis renders is not supported (docs/mlt.md)");
     if (r.settings.integrator == IntegratorKind::Vegas)
-      throw Error(inputs[k] + ": rendered with --integrator vegas; merging VEGAS renders is not supported (their warps "
-                  "were learned from overlapping numbers; docs/vegas.md)");
+      throw Error(inputs[k] + ": rendered with --integrator vegas; merging VEGAS renders is not supported (each part "
+                  "learned its own warp: the merge would not be one render of those samples; docs/vegas.md)");
     r.settings.width = static_cast<std::uint32_t>(img.width);
     r.settings.height = static_cast<std::uint32_t>(img.height);
     if (img.sum.empty() || img.sumSq.empty())

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <set>
@@ -71,9 +72,12 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
     if (settings.vegasBounces == 0 || settings.vegasBounces > settings.maxDepth + 1)
       throw Error("--vegas-bounces " + std::to_string(settings.vegasBounces) + ": between 1 and max depth + 1 (" +
                   std::to_string(settings.maxDepth + 1) + ")");
-    if (!(settings.vegasAlpha >= 0.01f && settings.vegasAlpha <= 1.0f))
-      throw Error("--vegas-alpha " + std::to_string(settings.vegasAlpha) +
+    if (!(settings.vegasAlpha >= 0.01f && settings.vegasAlpha <= 1.0f)) {
+      char value[32];
+      std::snprintf(value, sizeof value, "%g", double(settings.vegasAlpha));
+      throw Error(std::string("--vegas-alpha ") + value +
                   ": between 0.01 and 1 (the uniform share that keeps every bin's density > 0)");
+    }
   }
   m_settings.traversal = resolveTraversal(ctx, settings.traversal);
   m_summary.traversal = m_settings.traversal;
