@@ -5,8 +5,9 @@
 # reference (relMSE from `nusselt diff`). Prints per run and the medians: relMSE, the render's
 # sampling seconds (header nusselt/renderSeconds; a budget ends at a pass boundary, so the times
 # differ a little), paths per second, relMSE x seconds (lower is better: the error at equal time
-# for an error falling as 1 / time), and the ratio path / vegas of the medians' products (> 1:
-# vegas wins). The reference's own noise adds the same amount to both relMSEs.
+# for an error falling as 1 / time), relMSE x spp (the error per path, throughput aside), and the
+# ratio path / vegas of the medians' relMSE x s (> 1: vegas wins). The reference's own noise adds
+# the same amount to both relMSEs.
 #
 #   tools/bench_vegas.sh [DIR] [NUSSELT]
 # Environment: SIZE (default 128), TIME (10 s), REF_SPP (2048; the fast test scenes reach ~3000
@@ -54,8 +55,10 @@ for scene in $scenes; do
       # awk, not bc: relMSE may print as 1.5e-05, which bc does not read.
       prod=$(awk -v a="$rel" -v b="$sec" 'BEGIN { print a * b }')
       rate=$(awk -v n="$spp" -v s="$size" -v t="$sec" 'BEGIN { print n * s * s / t / 1000000 }')
-      printf "%-14s %-5s seed %d: relMSE %.5g  %.2f s  %d spp  %.3f Mpaths/s  relMSE x s %.5g\n" "$name" "$mode" "$r" "$rel" "$sec" "$spp" "$rate" "$prod"
-      echo "$rel $sec $prod $rate" >> "$dir/$name.$mode"
+      perPath=$(awk -v a="$rel" -v n="$spp" 'BEGIN { print a * n }')
+      printf "%-14s %-5s seed %d: relMSE %.5g  %.2f s  %d spp  %.3f Mpaths/s  relMSE x s %.5g  relMSE x spp %.4g\n" \
+        "$name" "$mode" "$r" "$rel" "$sec" "$spp" "$rate" "$prod" "$perPath"
+      echo "$rel $sec $prod $rate $perPath" >> "$dir/$name.$mode"
     done
   done
   for mode in path vegas; do
@@ -63,7 +66,9 @@ for scene in $scenes; do
     sec=$(awk '{print $2}' "$dir/$name.$mode" | median)
     prod=$(awk '{print $3}' "$dir/$name.$mode" | median)
     rate=$(awk '{print $4}' "$dir/$name.$mode" | median)
-    printf "%-14s %-5s median: relMSE %.5g  %.2f s  %.3f Mpaths/s  relMSE x s %.5g\n" "$name" "$mode" "$rel" "$sec" "$rate" "$prod"
+    perPath=$(awk '{print $5}' "$dir/$name.$mode" | median)
+    printf "%-14s %-5s median: relMSE %.5g  %.2f s  %.3f Mpaths/s  relMSE x s %.5g  relMSE x spp %.4g\n" "$name" "$mode" "$rel" \
+      "$sec" "$rate" "$prod" "$perPath"
     echo "$prod" > "$dir/$name.$mode.median"
   done
   printf "%-14s path / vegas (relMSE x s): %.3f\n" "$name" \

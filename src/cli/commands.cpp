@@ -60,7 +60,7 @@ struct RenderArgs {
   float mltLargeStep = 0.3f;
   float mltSigma = 0.01f;
   std::uint32_t vegasBins = 64;
-  std::uint32_t vegasBounces = 2;
+  std::uint32_t vegasBounces = 1;
   float vegasAlpha = 0.2f;
   std::string guiding = "off";
   std::uint32_t guideTrain = 0;

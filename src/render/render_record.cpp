@@ -205,7 +205,7 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   }
   if (r.settings.integrator == IntegratorKind::Vegas) {
     r.settings.vegasBins = static_cast<std::uint32_t>(findInt(meta, "nusselt/vegasBins").value_or(64));
-    r.settings.vegasBounces = static_cast<std::uint32_t>(findInt(meta, "nusselt/vegasBounces").value_or(2));
+    r.settings.vegasBounces = static_cast<std::uint32_t>(findInt(meta, "nusselt/vegasBounces").value_or(1));
     r.settings.vegasAlpha = static_cast<float>(findDouble(meta, "nusselt/vegasAlpha").value_or(0.2));
   }
   // Absent in unguided renders (and files written before guiding existed).

@@ -180,8 +180,8 @@ struct RenderSettings {
   // VEGAS (--integrator vegas, docs/vegas.md). Bins per warped axis (`--vegas-bins`, 1 .. 4096).
   std::uint32_t vegasBins = 64;
   // Bounces whose light choice, light point and BSDF draws are warped (`--vegas-bounces`, 1 ..
-  // max depth + 1; 5 axes each).
-  std::uint32_t vegasBounces = 2;
+  // max depth + 1; 5 axes each). 1: bounce 1's axes learned little and cost throughput (docs/vegas.md).
+  std::uint32_t vegasBounces = 1;
   // Weight of the uniform density in every learned one (`--vegas-alpha`, 0.01 .. 1; 1: no warp):
   // every bin keeps a density >= alpha, so the estimate stays unbiased and 1 / p_a <= 1 / alpha.
   float vegasAlpha = 0.2f;
