@@ -25,15 +25,22 @@ SHARED_BEGIN
 
 // ---- Queue ids --------------------------------------------------------------------------------
 // A queue is a count (queues[id]) plus path ids (queues[QUEUE_HEADER_UINTS + id * capacity + i]).
-// Ray queues ping-pong by bounce parity.
+// Ray queues ping-pong by bounce parity (ray queue b & 1 holds bounce b's rays), and so do the
+// shadow queues: shade(b) fills shadow queue b & 1, which the trace stage of bounce b + 1 consumes
+// together with that bounce's rays (PathIntegrator::recordPass).
 #define QUEUE_RAY0 0u
 #define QUEUE_RAY1 1u
-#define QUEUE_SHADOW 2u
+#define QUEUE_SHADOW0 2u
+#define QUEUE_SHADOW1 3u
 // Rays that hit nothing, for the escape stage (environment radiance); filled only when the scene
 // has an environment (Globals.environmentLight != INVALID_INDEX).
-#define QUEUE_ESCAPE 3u
-#define QUEUE_SHADE_BASE 4u
+#define QUEUE_ESCAPE 4u
+#define QUEUE_SHADE_BASE 5u
 #define QUEUE_COUNT (QUEUE_SHADE_BASE + MAX_MODEL_SLOTS)
+// Indirect dispatch sizes: one per queue (index = queue id), then the trace stage's two (index
+// ARGS_TRACE0 + (b & 1) for bounce b): the workgroups of its ray queue plus those of its shadow queue.
+#define ARGS_TRACE0 QUEUE_COUNT
+#define ARGS_COUNT (QUEUE_COUNT + 2u)
 
 // ---- Statistics counters (stats buffer, uint each) -----------------------------------------------
 // The one list of the counters the stages keep: X(ID, index, name, description). It declares the
@@ -334,7 +341,7 @@ struct Globals {
   BUFREF(Vec4s) shadowDirection;
   BUFREF(Vec4s) shadowRadiance;// per path: contribution if unoccluded
   BUFREF(Uints) queues;        // QUEUE_HEADER_UINTS counters, then QUEUE_COUNT item arrays
-  BUFREF(UVec4s) dispatchArgs; // QUEUE_COUNT DispatchArgs
+  BUFREF(UVec4s) dispatchArgs; // ARGS_COUNT DispatchArgs
   BUFREF(Uints) stats;         // STAT_COUNT counters
   BUFREF(QuadSets) quadSets;   // generic sampler: one set of trees per material (GpuMaterial.info.z)
   BUFREF(QuadTables) quadTables;
@@ -372,23 +379,13 @@ STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 40 * 8 + 8);
 struct BounceConstants {
   uint bounce;     // current bounce (0 = the camera ray's hit)
   uint modelSlot;  // shade: which shade queue (slot of the material table) to consume
-  uint reserved0;
+  uint traceMode;  // intersect: TRACE_BOTH, TRACE_RAYS or TRACE_SHADOWS (intersect.comp)
   uint reserved1;
 };
+#define TRACE_BOTH 0u
+#define TRACE_RAYS 1u
+#define TRACE_SHADOWS 2u
 STATIC_ASSERT_SIZE(BounceConstants, 16);
-
-// submit: turns queue counts into indirect dispatch arguments and empties consumed queues.
-struct SubmitConstants {
-  uint argsQueue;   // queue whose dispatch arguments to write, or INVALID_INDEX
-  uint argsFirst;   // first of a range of queues whose arguments to write
-  uint argsCount;
-  uint zeroFirst;   // first of a range of queues to empty
-  uint zeroCount;
-  uint bounce;      // the bounce whose ray queue argsQueue is (per-bounce ray counts)
-  uint reserved1;
-  uint reserved2;
-};
-STATIC_ASSERT_SIZE(SubmitConstants, 32);
 
 // display (the preview): tone mapping of the film into the display buffer.
 struct DisplayConstants {

@@ -150,6 +150,9 @@ uint queueItem(uint queue, uint i) { return g.queues.v[QUEUE_HEADER_UINTS + queu
 // to its model's shade queue): the lanes pushing to the same queue as the first remaining lane
 // take one atomic together, then the others repeat (at most one round per distinct queue; one
 // atomic per subgroup and queue instead of one per lane, which halves the cost on lavapipe).
+// The same lane keeps the queue's indirect dispatch size current (ceil(count / WORKGROUP_SIZE)
+// workgroups, by atomicMax: counts only grow while a queue fills), so that no stage between
+// producer and consumer has to turn counts into dispatch sizes (PathIntegrator::recordPass).
 void queuePush(uint queue, uint path) {
   for (int round = 0; round < 128; ++round) {
     uint leader = subgroupBroadcastFirst(queue);
@@ -158,7 +161,31 @@ void queuePush(uint queue, uint path) {
       uint n = subgroupBallotBitCount(ballot);
       uint rank = subgroupBallotExclusiveBitCount(ballot);
       uint base = 0u;
-      if (subgroupElect()) base = atomicAdd(g.queues.v[queue], n);
+      if (subgroupElect()) {
+        base = atomicAdd(g.queues.v[queue], n);
+        // Only a push that opens a workgroup (crosses a multiple of WORKGROUP_SIZE) touches the
+        // dispatch sizes: one in WORKGROUP_SIZE / subgroup size pushes, so the two cores rarely
+        // contend for their cache line (the count's atomic is the only one of the others).
+        uint groups = (base + n + WORKGROUP_SIZE - 1u) / WORKGROUP_SIZE;
+        uint opened = groups - (base + WORKGROUP_SIZE - 1u) / WORKGROUP_SIZE;
+        if (opened > 0u) {
+          Uints args = Uints(g.dispatchArgs);
+          atomicMax(args.v[4u * queue], groups);
+          args.v[4u * queue + 1u] = 1u;
+          args.v[4u * queue + 2u] = 1u;
+          // The trace stage that consumes this queue runs the workgroups of its ray queue and of
+          // its shadow queue in one dispatch: each push adds the workgroups it opened (the pushes'
+          // ranges are disjoint, so the additions sum to ceil(count / WORKGROUP_SIZE)). Ray queue q
+          // feeds trace(b) with b & 1 = q; shadow queue s (filled at bounce b, s = b & 1) feeds
+          // trace(b + 1).
+          if (queue <= QUEUE_SHADOW1) {
+            uint trace = ARGS_TRACE0 + (queue <= QUEUE_RAY1 ? queue : (queue - QUEUE_SHADOW0) ^ 1u);
+            atomicAdd(args.v[4u * trace], opened);
+            args.v[4u * trace + 1u] = 1u;
+            args.v[4u * trace + 2u] = 1u;
+          }
+        }
+      }
       base = subgroupBroadcastFirst(base);
       g.queues.v[QUEUE_HEADER_UINTS + queue * g.pathCapacity + base + rank] = path;
       return;

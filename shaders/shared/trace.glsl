@@ -10,7 +10,7 @@
 // modules, CMakeLists.txt), the device's ray queries against the acceleration structures of
 // DeviceScene (one bottom level over the scene's triangles in g.triangles order, one top-level
 // instance with the identity transform, so primitive index = triangle index); otherwise the GLSL
-// BVH of shared/bvh_traverse.glsl. Both return the same hit record, so the stages that shade a
+// BVH of shared/bvh_traverse.h. Both return the same hit record, so the stages that shade a
 // hit do not know which one ran. Hits may differ in the last bits of t and b (different
 // arithmetic) and, for rays through a shared edge, in which of its triangles is hit.
 
@@ -74,7 +74,7 @@ bool traceAny(vec3 origin, vec3 dir, float tmin, float tmax) {
 }
 
 #else
-#include "shared/bvh_traverse.glsl"
+#include "shared/bvh_traverse.h"
 #endif
 
 #endif

@@ -47,5 +47,9 @@ void main() {
   g.pathRadiance.v[i] = vec4(0.0f);
   g.pathInfo.v[i] = uvec4(pixel, sampleIndex, 0u, 0u);
   g.queues.v[QUEUE_HEADER_UINTS + QUEUE_RAY0 * g.pathCapacity + i] = i;
-  if (i == 0u) g.queues.v[QUEUE_RAY0] = g.chunkPaths;
+  if (i == 0u) {
+    g.queues.v[QUEUE_RAY0] = g.chunkPaths;
+    g.dispatchArgs.v[QUEUE_RAY0] = uvec4((g.chunkPaths + WORKGROUP_SIZE - 1u) / WORKGROUP_SIZE, 1u, 1u, 0u);
+    g.dispatchArgs.v[ARGS_TRACE0] = g.dispatchArgs.v[QUEUE_RAY0];
+  }
 }

@@ -1,15 +1,27 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// intersect: closest hit for every path in the current ray queue. Hits go to the shade queue of
-// their material's model; escaping rays go to the escape queue when the scene has an environment
-// (escape.comp), and end otherwise.
+// intersect: the trace stage of bounce b, one dispatch for both kinds of ray of that bounce:
+// - the closest hit of every path in ray queue b & 1. Hits go to the shade queue of their
+//   material's model; escaping rays go to the escape queue when the scene has an environment
+//   (escape.comp), and end otherwise;
+// - the any-hit test of every shadow ray that shade(b - 1) queued (shadow queue (b - 1) & 1):
+//   unoccluded ones add their contribution to their path's radiance.
+// Workgroups [0, ceil(rays / WORKGROUP_SIZE)) take the rays, the following ones the shadow rays
+// (the dispatch size, ARGS_TRACE0 + (b & 1), counts both: queuePush). One dispatch and one barrier
+// fewer per bounce than a shadow stage of its own; a workgroup is all of one kind, so no group
+// pays for both. Timed renders (--time-stages, bench render) dispatch the two kinds separately
+// (pc.traceMode) to report their GPU times apart.
 #include "shared/stage_common.glsl"
 STAGE_PUSH(BounceConstants);
 
-void main() {
-  uint queue = pc.bounce & 1u;
-  uint idx = gl_GlobalInvocationID.x;
-  if (idx >= queueCount(queue)) return;
+void traceRay(uint queue, uint idx) {
+  uint count = queueCount(queue);
+  if (idx >= count) return;
+  // Rays traced, in all and at this bounce (the queue is complete while it is consumed).
+  if (idx == 0u) {
+    atomicAdd(g.stats.v[STAT_RAYS], count);
+    atomicAdd(g.stats.v[STAT_PER_BOUNCE + min(pc.bounce, STAT_BOUNCE_SLOTS - 1u)], count);
+  }
   uint path = queueItem(queue, idx);
 
   vec3 o = g.pathOrigin.v[path].xyz;
@@ -25,4 +37,24 @@ void main() {
   } else if (g.environmentLight != INVALID_INDEX) {
     queuePush(QUEUE_ESCAPE, path);
   }
+}
+
+void traceShadow(uint queue, uint idx) {
+  uint count = queueCount(queue);
+  if (idx >= count) return;
+  if (idx == 0u) atomicAdd(g.stats.v[STAT_SHADOW_RAYS], count);
+  uint path = queueItem(queue, idx);
+  vec4 o = g.shadowOrigin.v[path];
+  vec3 d = g.shadowDirection.v[path].xyz;
+  if (!traceAny(o.xyz, d, 0.0f, o.w)) g.pathRadiance.v[path].xyz += g.shadowRadiance.v[path].xyz;
+}
+
+void main() {
+  uint rayQueue = pc.bounce & 1u;
+  uint shadowQueue = QUEUE_SHADOW0 + ((pc.bounce + 1u) & 1u);
+  uint rayGroups = 0u;
+  if (pc.traceMode != TRACE_SHADOWS) rayGroups = (queueCount(rayQueue) + WORKGROUP_SIZE - 1u) / WORKGROUP_SIZE;
+  uint group = gl_WorkGroupID.x;
+  if (group < rayGroups) traceRay(rayQueue, gl_GlobalInvocationID.x);
+  else if (pc.traceMode != TRACE_RAYS) traceShadow(shadowQueue, (group - rayGroups) * WORKGROUP_SIZE + gl_LocalInvocationID.x);
 }

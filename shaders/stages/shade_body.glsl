@@ -370,7 +370,7 @@ void nextEvent(ShadeMaterial m, uint path, PathKey k, uint bounce, uint lighting
       g.shadowOrigin.v[path] = vec4(xo, tmax);
       g.shadowDirection.v[path] = vec4(ls.wi, 0.0f);
       g.shadowRadiance.v[path] = vec4(c, 0.0f);
-      queuePush(QUEUE_SHADOW, path);
+      queuePush(QUEUE_SHADOW0 + (bounce & 1u), path);
     }
   }
 }

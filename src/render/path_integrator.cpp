@@ -16,7 +16,6 @@ namespace nusselt {
 using shared::DispatchArgs;
 using shared::Globals;
 using shared::BounceConstants;
-using shared::SubmitConstants;
 
 std::uint32_t PathIntegrator::capacityFor(const RenderSettings& settings, std::uint64_t pixels, std::uint32_t samples) {
   std::uint32_t maxChunk = std::min<std::uint32_t>(settings.maxPathsPerChunk, 65535u * WORKGROUP_SIZE);
@@ -76,7 +75,7 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   std::uint64_t queueUints = QUEUE_HEADER_UINTS + (QUEUE_SHADE_BASE + m_slotKeys.size()) * cap;
   m_queues = make(queueUints * 4, "queue");
   g.queues = m_queues->address;
-  m_args = make(QUEUE_COUNT * sizeof(DispatchArgs), "dispatch arguments", VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+  m_args = make(ARGS_COUNT * sizeof(DispatchArgs), "dispatch arguments", VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
   g.dispatchArgs = m_args->address;
   m_stats = make(STAT_BUFFER_UINTS * 4, "statistics", 0, true);
   std::memset(m_stats->mapped, 0, STAT_BUFFER_UINTS * 4);
@@ -121,7 +120,7 @@ PathIntegrator::~PathIntegrator() {
   if (m_fence) vkDestroyFence(d, m_fence, nullptr);
   if (m_queryPool) vkDestroyQueryPool(d, m_queryPool, nullptr);
   if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
-  for (auto* p : {&m_camera, &m_submit, &m_intersect, &m_escape, &m_shadow, &m_accumulate})
+  for (auto* p : {&m_camera, &m_intersect, &m_escape, &m_accumulate})
     if (p->pipeline) vk::destroyComputePipeline(m_ctx, *p);
   for (auto& p : m_shade) vk::destroyComputePipeline(m_ctx, p);
   for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
@@ -150,7 +149,6 @@ void PathIntegrator::createPipelines() {
     m_camera = vk::createComputePipeline(m_ctx, layout, "camera",
                                          {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, primary, m_options.imageSamples ? 1u : 0u});
   else m_camera = vk::createComputePipeline(m_ctx, layout, "camera");
-  m_submit = vk::createComputePipeline(m_ctx, layout, "submit");
   // The tracing stages' module for the traversal (the Renderer resolved Auto): <stage>_rq with ray
   // queries, <stage> with the GLSL BVH (CMakeLists.txt). Only the used one is compiled.
   const std::string tracing = m_settings.traversal == Traversal::RayQuery ? "_rq" : "";
@@ -169,7 +167,6 @@ void PathIntegrator::createPipelines() {
                                            {0, 0, 0, 0, 0, 0, 0, 1u, m_hasTextures ? 1u : 0u, 0u, guiding, primary});
     else m_escape = vk::createComputePipeline(m_ctx, layout, "escape");
   }
-  m_shadow = vk::createComputePipeline(m_ctx, layout, "shadow" + tracing + alpha, traceSpec);
   m_accumulate = vk::createComputePipeline(m_ctx, layout, "accumulate");
   // Only the models (and combinations) this scene uses: one specialised shade pipeline each,
   // created on all cores (drivers compile at creation; lavapipe takes ~0.3 s per shade pipeline,
@@ -220,20 +217,14 @@ void PathIntegrator::createPipelines() {
     if (!e.empty()) throw Error(e);
 }
 
-void PathIntegrator::dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst,
-                                    std::uint32_t zeroCount, std::uint32_t argsFirst, std::uint32_t argsCount,
-                                    std::uint32_t bounce) {
-  SubmitConstants pc{};
-  pc.bounce = bounce;
-  pc.argsQueue = queueA;
-  pc.argsFirst = argsFirst;
-  pc.argsCount = argsCount;
-  pc.zeroFirst = zeroFirst;
-  pc.zeroCount = zeroCount;
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_submit.pipeline);
-  vkCmdPushConstants(cmd, m_globals.layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
-  vkCmdDispatch(cmd, 1, 1, 1);
-  vk::computeBarrier(cmd);
+void PathIntegrator::emptyQueues(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t count) {
+  if (count == 0) return;
+  vkCmdFillBuffer(cmd, m_queues->buffer, first * 4, count * 4, 0);
+  vkCmdFillBuffer(cmd, m_args->buffer, first * sizeof(DispatchArgs), count * sizeof(DispatchArgs), 0);
+}
+
+void PathIntegrator::emptyTraceArgs(VkCommandBuffer cmd, std::uint32_t parity) {
+  vkCmdFillBuffer(cmd, m_args->buffer, (ARGS_TRACE0 + parity) * sizeof(DispatchArgs), sizeof(DispatchArgs), 0);
 }
 
 void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, bool accumulate) {
@@ -244,8 +235,9 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, b
   m_marks.clear();
   if (m_queryPool) vkCmdResetQueryPool(cmd, m_queryPool, 0, m_queryCapacity);
   mark(cmd, nullptr);
-  // All queues start empty.
+  // All queues start empty (counts and dispatch sizes).
   vkCmdFillBuffer(cmd, m_queues->buffer, 0, QUEUE_HEADER_UINTS * 4, 0);
+  vkCmdFillBuffer(cmd, m_args->buffer, 0, VK_WHOLE_SIZE, 0);
   // Path guiding's training records start as "ended here" (guiding_layout.h).
   if (m_guide && m_guide->recording()) vkCmdFillBuffer(cmd, m_guide->records().buffer, 0, VK_WHOLE_SIZE, 0);
   vk::computeBarrier(cmd);
@@ -261,19 +253,44 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, b
   vk::computeBarrier(cmd);
   mark(cmd, "camera");
 
+  // Queue sizes need no stage of their own: the pushes keep each queue's indirect dispatch size
+  // current (queuePush, stage_common.glsl), and the consumers tally the rays they trace. A bounce
+  // b is two dispatches: the trace stage (intersect.comp: ray queue b & 1 and the shadow rays of
+  // bounce b - 1, shadow queue (b - 1) & 1) and shade. Before trace(b) the queues that bounce b - 1
+  // consumed are emptied in one place: ray queue (b - 1) & 1, shadow queue b & 1, the escape and
+  // shade queues, and trace(b - 1)'s dispatch size (shade(b) sizes trace(b + 1) there).
   for (std::uint32_t bounce = 0; bounce <= m_settings.maxDepth; ++bounce) {
     const std::uint32_t rayQueue = bounce & 1u;
     pc.bounce = bounce;
-    // intersect <- ray queue; empties the shadow queue of the previous bounce.
-    dispatchSubmit(cmd, rayQueue, QUEUE_SHADOW, 1, 0, 0, bounce);
-    mark(cmd, "submit");
-    bindAndPush(m_intersect);
-    vkCmdDispatchIndirect(cmd, m_args->buffer, rayQueue * sizeof(DispatchArgs));
-    vk::computeBarrier(cmd);
-    mark(cmd, "intersect");
-    // escape, shade(model) <- escape and shade queues; empties the consumed ray queue.
-    dispatchSubmit(cmd, INVALID_INDEX, rayQueue, 1, QUEUE_ESCAPE, slots + 1);
-    mark(cmd, "submit");
+    if (bounce > 0) {
+      static_assert(QUEUE_RAY0 == 0 && QUEUE_RAY1 == 1 && QUEUE_SHADOW0 == 2 && QUEUE_SHADOW1 == 3 &&
+                    QUEUE_ESCAPE == 4 && QUEUE_SHADE_BASE == 5);
+      const std::uint32_t consumedRays = rayQueue ^ 1u;
+      const std::uint32_t consumedShadows = QUEUE_SHADOW0 + rayQueue;
+      emptyQueues(cmd, consumedRays, 1);
+      emptyQueues(cmd, consumedShadows, 1);
+      emptyQueues(cmd, QUEUE_ESCAPE, QUEUE_SHADE_BASE + slots - QUEUE_ESCAPE);
+      emptyTraceArgs(cmd, rayQueue ^ 1u);
+      vk::computeBarrier(cmd);
+    }
+    if (m_queryPool) {  // timed runs only: rays and shadow rays on their own, to time them apart
+      pc.traceMode = TRACE_RAYS;
+      bindAndPush(m_intersect);
+      vkCmdDispatchIndirect(cmd, m_args->buffer, rayQueue * sizeof(DispatchArgs));
+      vk::computeBarrier(cmd);
+      mark(cmd, "intersect");
+      pc.traceMode = TRACE_SHADOWS;
+      bindAndPush(m_intersect);
+      vkCmdDispatchIndirect(cmd, m_args->buffer, (QUEUE_SHADOW0 + (rayQueue ^ 1u)) * sizeof(DispatchArgs));
+      vk::computeBarrier(cmd);
+      mark(cmd, "shadow");
+      pc.traceMode = TRACE_BOTH;
+    } else {
+      bindAndPush(m_intersect);
+      vkCmdDispatchIndirect(cmd, m_args->buffer, (ARGS_TRACE0 + rayQueue) * sizeof(DispatchArgs));
+      vk::computeBarrier(cmd);
+    }
+    // escape, shade(model) <- escape and shade queues.
     if (m_hasEscape) {
       bindAndPush(m_escape);
       vkCmdDispatchIndirect(cmd, m_args->buffer, QUEUE_ESCAPE * sizeof(DispatchArgs));
@@ -290,13 +307,7 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, b
       }
     }
     vk::computeBarrier(cmd);
-    // shadow <- shadow queue; empties the escape and shade queues.
-    dispatchSubmit(cmd, QUEUE_SHADOW, QUEUE_ESCAPE, slots + 1, 0, 0);
-    mark(cmd, "submit");
-    bindAndPush(m_shadow);
-    vkCmdDispatchIndirect(cmd, m_args->buffer, QUEUE_SHADOW * sizeof(DispatchArgs));
-    vk::computeBarrier(cmd);
-    mark(cmd, "shadow");
+    // (shade(maxDepth) queues no shadow rays: the last bounce takes no light sample.)
   }
   if (!accumulate) return;
   bindAndPush(m_accumulate);

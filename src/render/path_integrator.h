@@ -1,9 +1,10 @@
 // path_integrator.h: the wavefront path tracer. Each pass traces one path per pixel through the
 // stages
-//   camera -> [intersect -> escape -> shade(slot) -> shadow] x (max depth + 1) -> accumulate
+//   camera -> [intersect (+ the previous bounce's shadow rays) -> escape -> shade(slot)] x (max depth + 1)
+//          -> accumulate
 // (escape only for scenes with an environment)
-// with queues between them: a queue is a count plus path ids, and the one-workgroup submit stage
-// turns counts into indirect dispatch sizes, so every stage processes only live paths.
+// with queues between them: a queue is a count plus path ids, and every push keeps the queue's
+// indirect dispatch size current, so every stage processes only live paths.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -82,8 +83,10 @@ class PathIntegrator : public Integrator {
  private:
   void createPipelines();
   void recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, bool accumulate = true);
-  void dispatchSubmit(VkCommandBuffer cmd, std::uint32_t queueA, std::uint32_t zeroFirst, std::uint32_t zeroCount,
-                      std::uint32_t argsFirst, std::uint32_t argsCount, std::uint32_t bounce = 0);
+  // Empties queues [first, first + count): their counts and indirect dispatch sizes.
+  void emptyQueues(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t count);
+  // Empties the trace stage's dispatch size ARGS_TRACE0 + parity.
+  void emptyTraceArgs(VkCommandBuffer cmd, std::uint32_t parity);
   void mark(VkCommandBuffer cmd, const char* stage);
 
   vk::Context& m_ctx;
@@ -100,7 +103,7 @@ class PathIntegrator : public Integrator {
   vk::Buffer* m_args = nullptr;
   vk::Buffer* m_stats = nullptr;
 
-  vk::ComputePipeline m_camera, m_submit, m_intersect, m_escape, m_shadow, m_accumulate;
+  vk::ComputePipeline m_camera, m_intersect, m_escape, m_accumulate;
   bool m_hasEscape = false;
   bool m_hasTextures = false;  // spec constant HAS_TEXTURES of the shade stages
   bool m_hasAlpha = false;     // spec constant HAS_ALPHA of the tracing stages

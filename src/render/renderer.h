@@ -84,7 +84,7 @@ class Renderer {
   // Adds counts carried over from a resumed render to the statistics.
   void addStats(const RenderStats& carried) { m_integrator->addStats(carried); }
   RenderStats stats() const { return m_integrator->stats(); }
-  // GPU time per stage name (camera, submit, intersect, "shade <model>" per shade pipeline, shadow,
+  // GPU time per stage name (camera, intersect, "shade <model>" per shade pipeline, shadow,
   // accumulate) summed over all passes so far; empty unless RenderSettings::timeStages.
   const std::vector<std::pair<std::string, double>>& stageSeconds() const { return m_integrator->stageSeconds(); }
   // Extension rays per bounce over all passes so far (Integrator::raysPerBounce).

@@ -84,7 +84,7 @@ enum class RouletteMode : std::uint32_t { Throughput = ROULETTE_THROUGHPUT, Albe
 inline constexpr EnumName<RouletteMode> kRouletteNames[] = {{RouletteMode::Throughput, "throughput"},
                                                             {RouletteMode::Albedo, "albedo"}};
 
-// Scene traversal of the intersect and shadow stages (shaders/shared/trace.glsl): rayquery = the
+// Scene traversal of the intersect stage (rays and shadow rays) (shaders/shared/trace.glsl): rayquery = the
 // device's ray queries against acceleration structures, bvh = the GLSL BVH (every device), auto =
 // rayquery on a GPU that offers it, else bvh (resolveTraversal, renderer.h). Not a shader value:
 // it selects the stages' modules.

@@ -1,6 +1,8 @@
-// bvh.cpp: binned-SAH BVH builder (see bvh.h for the node encoding) and the C++ reference
-// traversal that mirrors shaders/shared/bvh_traverse.glsl.
+// bvh.cpp: binned-SAH BVH builder (see bvh.h for the node encoding) and the C++ entry points of
+// the traversal the GPU runs (shaders/shared/bvh_traverse.h).
 #include "scene/bvh.h"
+
+#include "../../shaders/shared/bvh_traverse.h"
 
 #include <algorithm>
 #include <array>
@@ -378,129 +380,70 @@ Bvh buildBvh(const std::vector<glm::vec3>& positions) {
   return bvh;
 }
 
-// ---- Reference traversal: keep in step with shaders/shared/bvh_traverse.glsl ---------------------
+// ---- Reference traversal: the shared one of shaders/shared/bvh_traverse.h ----------------------
 
 namespace {
 
-// Widening of a box's exit distance: covers the rounding of the slab computation so that a
-// triangle lying in a box face (flat boxes) is never culled (1 + 2 gamma(3), PBRT 4 6.8.2).
-constexpr float kSlabExitScale = 1.0000004f;
-// Smallest direction component used for the inverse: keeps 1/d finite, so (plane - o) * inv
-// never evaluates 0 * inf = NaN. Replacing a zero component by +-1e-30 tilts the ray by a
-// negligible angle; its one visible effect is that a ray lying exactly in a box face plane is
-// inside the slab at one face (the min face for +0) and outside at the other. The only hits that
-// can be lost are thus on triangle edges lying exactly in such a plane (e.g. a straight-down ray
-// through the outer edge of an axis-aligned floor): grazing hits, which Moller-Trumbore's
-// edge test already decides arbitrarily.
-constexpr float kMinDirection = 1e-30f;
+bool callFilter(const void* context, std::uint32_t tri, float b1, float b2, glm::vec3 origin, glm::vec3 dir) {
+  return (*static_cast<const BvhHitFilter*>(context))(tri, b1, b2, origin, dir);
+}
 
-struct RayBoxSetup {
-  glm::vec3 origin, inv;
-  glm::bvec3 positive;
+// Points the calling thread's g_bvhHost at this scene for the lifetime of the object.
+class HostScope {
+ public:
+  HostScope(const Bvh& bvh, const std::vector<glm::vec3>& positions, const BvhHitFilter& passes) {
+    m_host.nodes = bvh.nodes.data();
+    m_host.nodeCount = static_cast<std::uint32_t>(bvh.nodes.size());
+    m_host.positions = positions.data();
+    m_host.triangleOrder = bvh.triangleOrder.data();
+    if (passes) {
+      m_host.passes = callFilter;
+      m_host.passesContext = &passes;
+    }
+    m_previous = shared::g_bvhHost;
+    shared::g_bvhHost = &m_host;
+  }
+  ~HostScope() { shared::g_bvhHost = m_previous; }
+  HostScope(const HostScope&) = delete;
+  HostScope& operator=(const HostScope&) = delete;
+
+ private:
+  shared::BvhHost m_host;
+  shared::BvhHost* m_previous = nullptr;
 };
-
-RayBoxSetup setupRay(glm::vec3 origin, glm::vec3 dir) {
-  RayBoxSetup r;
-  r.origin = origin;
-  for (int a = 0; a < 3; ++a) {
-    const float d = std::abs(dir[a]) >= kMinDirection ? dir[a] : (dir[a] >= 0.0f ? kMinDirection : -kMinDirection);
-    r.inv[a] = 1.0f / d;
-    r.positive[a] = r.inv[a] >= 0.0f;
-  }
-  return r;
-}
-
-// Slab test choosing the entry plane by direction sign (not min/max of both planes): an inverted
-// (empty) box then gives entry +inf > exit -inf and is missed.
-bool hitBox(const RayBoxSetup& r, glm::vec4 bmin, glm::vec4 bmax, float tmin, float tmax, float& tEnter) {
-  glm::vec3 nearPlane, farPlane;
-  for (int a = 0; a < 3; ++a) {
-    nearPlane[a] = r.positive[a] ? bmin[a] : bmax[a];
-    farPlane[a] = r.positive[a] ? bmax[a] : bmin[a];
-  }
-  const glm::vec3 tn = (nearPlane - r.origin) * r.inv;
-  const glm::vec3 tf = (farPlane - r.origin) * r.inv;
-  tEnter = std::max(std::max(tn.x, tn.y), std::max(tn.z, tmin));
-  const float tExit = std::min(std::min(tf.x, tf.y), std::min(tf.z, tmax)) * kSlabExitScale;
-  return tEnter <= tExit;
-}
 
 }  // namespace
 
 bool intersectTriangle(glm::vec3 origin, glm::vec3 dir, glm::vec3 v0, glm::vec3 e1, glm::vec3 e2,
                        float tmin, float tmax, float& t, float& b1, float& b2) {
-  const glm::vec3 p = glm::cross(dir, e2);
-  const float det = glm::dot(e1, p);
-  if (det == 0.0f) return false;
-  const float invDet = 1.0f / det;
-  const glm::vec3 s = origin - v0;
-  const float u = glm::dot(s, p) * invDet;
-  const glm::vec3 q = glm::cross(s, e1);
-  const float v = glm::dot(dir, q) * invDet;
-  const float tt = glm::dot(e2, q) * invDet;
-  // Written as conjunctions so that a NaN anywhere rejects the hit.
-  if (u >= 0.0f && v >= 0.0f && u + v <= 1.0f && tt > tmin && tt < tmax) {
-    t = tt;
-    b1 = u;
-    b2 = v;
-    return true;
-  }
-  return false;
+  shared::GpuTriangle tri;
+  tri.v0 = glm::vec4(v0, 0.0f);
+  tri.e1 = glm::vec4(e1, 0.0f);
+  tri.e2 = glm::vec4(e2, 0.0f);
+  float tt, u, v;
+  if (!shared::bvhHitTriangle(origin, dir, tri, tmin, tmax, tt, u, v)) return false;
+  t = tt;
+  b1 = u;
+  b2 = v;
+  return true;
 }
 
 bool bvhClosestHit(const Bvh& bvh, const std::vector<glm::vec3>& positions, glm::vec3 origin,
                    glm::vec3 dir, float tmin, float tmax, float& t, std::uint32_t& tri,
                    const BvhHitFilter& passes) {
-  if (bvh.nodes.empty()) return false;
-  const RayBoxSetup ray = setupRay(origin, dir);
-  std::uint32_t stack[BVH_STACK_SIZE];
-  int sp = 0;
-  std::uint32_t node = 0;
-  float best = tmax;
-  bool found = false;
-  auto testLeaf = [&](std::uint32_t first, std::uint32_t count) {
-    for (std::uint32_t i = first; i < first + count; ++i) {
-      const std::uint32_t o = bvh.triangleOrder[i];
-      const glm::vec3 v0 = positions[3 * o];
-      float tt, b1, b2;
-      if (intersectTriangle(origin, dir, v0, positions[3 * o + 1] - v0, positions[3 * o + 2] - v0, tmin,
-                            best, tt, b1, b2) &&
-          (!passes || passes(i, b1, b2, origin, dir))) {
-        best = tt;
-        tri = i;
-        found = true;
-      }
-    }
-  };
-  for (;;) {
-    const BvhNode& n = bvh.nodes[node];
-    float enter0, enter1;
-    bool hit0 = hitBox(ray, n.min0, n.max0, tmin, best, enter0);
-    bool hit1 = hitBox(ray, n.min1, n.max1, tmin, best, enter1);
-    if (hit0 && n.link.z > 0) {
-      testLeaf(n.link.x, n.link.z);
-      hit0 = false;
-    }
-    if (hit1 && n.link.w > 0) {
-      testLeaf(n.link.y, n.link.w);
-      hit1 = false;
-    }
-    if (hit0 && hit1) {
-      if (sp >= BVH_STACK_SIZE) break;  // the GPU counts STAT_BVH_STACK_OVERFLOW here
-      const bool firstNear = enter0 <= enter1;
-      stack[sp++] = firstNear ? n.link.y : n.link.x;
-      node = firstNear ? n.link.x : n.link.y;
-    } else if (hit0) {
-      node = n.link.x;
-    } else if (hit1) {
-      node = n.link.y;
-    } else {
-      if (sp == 0) break;
-      node = stack[--sp];
-    }
-  }
-  if (found) t = best;
-  return found;
+  HostScope scope(bvh, positions, passes);
+  float tt, b1, b2;
+  std::uint32_t index;
+  if (!shared::traceClosest(origin, dir, tmin, tmax, tt, b1, b2, index)) return false;
+  t = tt;
+  tri = index;
+  return true;
+}
+
+bool bvhAnyHit(const Bvh& bvh, const std::vector<glm::vec3>& positions, glm::vec3 origin, glm::vec3 dir,
+               float tmin, float tmax, const BvhHitFilter& passes) {
+  HostScope scope(bvh, positions, passes);
+  return shared::traceAny(origin, dir, tmin, tmax);
 }
 
 std::vector<std::uint32_t> mortonOrder(const std::vector<glm::vec3>& positions) {

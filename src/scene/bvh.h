@@ -1,5 +1,5 @@
-// bvh.h: the CPU builder of the bounding volume hierarchy the GPU traverses
-// (shaders/shared/bvh_traverse.glsl).
+// bvh.h: the CPU builder of the bounding volume hierarchy the GPU traverses, and the C++ entry
+// points of that traversal (shaders/shared/bvh_traverse.h, one source for both builds).
 //
 // Node encoding (shared::BvhNode, shaders/shared/layout.h): a node stores the boxes of both of
 // its children; link = (child0, child1, count0, count1).
@@ -68,18 +68,23 @@ std::vector<std::uint32_t> mortonOrder(const std::vector<glm::vec3>& positions);
 // for a scene is AlphaTester (src/render/texture_table.h).
 using BvhHitFilter = std::function<bool(std::uint32_t tri, float b1, float b2, glm::vec3 origin, glm::vec3 dir)>;
 
-// The C++ twin of traceClosest in bvh_traverse.glsl: same slab test, same Moller-Trumbore, same
-// stack discipline. positions are the ORIGINAL (not reordered) positions given to buildBvh; tri
-// is returned as an index into the reordered array (as on the GPU): the original triangle is
+// traceClosest of shaders/shared/bvh_traverse.h (the code the GPU runs without ray queries) over
+// this BVH. positions are the ORIGINAL (not reordered) positions given to buildBvh; tri is
+// returned as an index into the reordered array (as on the GPU): the original triangle is
 // bvh.triangleOrder[tri]. Returns the nearest hit with tmin < t < tmax that `passes` accepts
 // (every hit without it: an opaque scene; with the scene's AlphaTester: MASK and BLEND as the GPU
-// traversal of a scene with alpha, HAS_ALPHA).
+// traversal of a scene with alpha, HAS_ALPHA); t and tri are left unchanged on a miss.
 bool bvhClosestHit(const Bvh& bvh, const std::vector<glm::vec3>& positions, glm::vec3 origin,
                    glm::vec3 dir, float tmin, float tmax, float& t, std::uint32_t& tri,
                    const BvhHitFilter& passes = nullptr);
 
-// Moller-Trumbore against one triangle (v0, e1 = v1 - v0, e2 = v2 - v0), both faces, exactly as
-// the GPU computes it. Exposed so that tests can brute-force with the same arithmetic.
+// traceAny of shaders/shared/bvh_traverse.h (shadow rays): whether a hit with tmin < t < tmax
+// that `passes` accepts exists.
+bool bvhAnyHit(const Bvh& bvh, const std::vector<glm::vec3>& positions, glm::vec3 origin, glm::vec3 dir,
+               float tmin, float tmax, const BvhHitFilter& passes = nullptr);
+
+// Moller-Trumbore against one triangle (v0, e1 = v1 - v0, e2 = v2 - v0), both faces: the GPU's
+// bvhHitTriangle (shared/bvh_traverse.h). Exposed so that tests can brute-force with the same arithmetic.
 bool intersectTriangle(glm::vec3 origin, glm::vec3 dir, glm::vec3 v0, glm::vec3 e1, glm::vec3 e2,
                        float tmin, float tmax, float& t, float& b1, float& b2);
 

@@ -25,6 +25,12 @@ const char* kInstallHint =
     "install a Vulkan loader and driver: apt-get install libvulkan1 mesa-vulkan-drivers "
     "(mesa-vulkan-drivers provides lavapipe, a CPU device that is enough to render)";
 
+// volk keeps one global table of instance and device functions, loaded for the context created
+// last. A process may hold several contexts (the tests: a shared one plus one without ray
+// queries); when the newest is destroyed, the table goes back to the newest that is still alive,
+// so its extension functions (acceleration structures) are not left pointing at a dead device.
+std::vector<Context*> g_liveContexts;
+
 void initLoader() {
   static bool done = false;
   if (done) return;
@@ -367,6 +373,7 @@ void createContext(Context& ctx, const ContextOptions& options) {
   dci.ppEnabledExtensionNames = extensions.data();
   VK_CHECK(vkCreateDevice(ctx.physical, &dci, nullptr, &ctx.device));
   volkLoadDevice(ctx.device);
+  g_liveContexts.push_back(&ctx);
   vkGetDeviceQueue(ctx.device, family, 0, &ctx.queue);
 
   VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
@@ -387,6 +394,12 @@ void destroyContext(Context& ctx) {
   ctx.instance = VK_NULL_HANDLE;
   ctx.messenger = VK_NULL_HANDLE;
   ctx.commandPool = VK_NULL_HANDLE;
+  const bool wasCurrent = !g_liveContexts.empty() && g_liveContexts.back() == &ctx;
+  g_liveContexts.erase(std::remove(g_liveContexts.begin(), g_liveContexts.end(), &ctx), g_liveContexts.end());
+  if (wasCurrent && !g_liveContexts.empty()) {
+    volkLoadInstanceOnly(g_liveContexts.back()->instance);
+    volkLoadDevice(g_liveContexts.back()->device);
+  }
 }
 
 Buffer createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags extraUsage, bool hostVisible,

@@ -178,6 +178,14 @@ void checkRays(const Bvh& bvh, const std::vector<glm::vec3>& p, const std::vecto
     bool hr = bruteForce(p, o, d, tmin, kInf, tr, ir);
     ASSERT_EQ(hb, hr) << "o=(" << o.x << "," << o.y << "," << o.z << ") d=(" << d.x << "," << d.y << "," << d.z
                       << ")";
+    // The shadow-ray traversal (traceAny): a hit exists exactly when the closest one does, none
+    // lies before the closest (same triangle arithmetic as brute force), and the closest itself
+    // is found when the interval just includes it.
+    ASSERT_EQ(bvhAnyHit(bvh, p, o, d, tmin, kInf), hr);
+    if (hr) {
+      ASSERT_FALSE(bvhAnyHit(bvh, p, o, d, tmin, tr)) << "t=" << tr;
+      ASSERT_TRUE(bvhAnyHit(bvh, p, o, d, tmin, std::nextafter(tr, kInf))) << "t=" << tr;
+    }
     if (!hb) continue;
     hits++;
     ASSERT_LT(ib, bvh.triangleOrder.size());
