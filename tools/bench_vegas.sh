@@ -52,10 +52,9 @@ for scene in $scenes; do
       sec=$(attr "$out" renderSeconds)
       spp=$(attr "$out" spp)
       rel=$("$bin" diff "$out" "$ref" | awk '{print $2}')
-      # awk, not bc: relMSE may print as 1.5e-05, which bc does not read.
-      prod=$(awk -v a="$rel" -v b="$sec" 'BEGIN { print a * b }')
-      rate=$(awk -v n="$spp" -v s="$size" -v t="$sec" 'BEGIN { print n * s * s / t / 1000000 }')
-      perPath=$(awk -v a="$rel" -v n="$spp" 'BEGIN { print a * n }')
+      prod=$(calc "$rel * $sec")
+      rate=$(calc "$spp * $size * $size / $sec / 1000000")
+      perPath=$(calc "$rel * $spp")
       printf "%-14s %-5s seed %d: relMSE %.5g  %.2f s  %d spp  %.3f Mpaths/s  relMSE x s %.5g  relMSE x spp %.4g\n" \
         "$name" "$mode" "$r" "$rel" "$sec" "$spp" "$rate" "$prod" "$perPath"
       echo "$rel $sec $prod $rate $perPath" >> "$dir/$name.$mode"
@@ -72,5 +71,5 @@ for scene in $scenes; do
     echo "$prod" > "$dir/$name.$mode.median"
   done
   printf "%-14s path / vegas (relMSE x s): %.3f\n" "$name" \
-    "$(awk -v a="$(cat "$dir/$name.path.median")" -v b="$(cat "$dir/$name.vegas.median")" 'BEGIN { print a / b }')"
+    "$(calc "$(cat "$dir/$name.path.median") / $(cat "$dir/$name.vegas.median")")"
 done
