@@ -50,7 +50,7 @@ for scene in $scenes; do
       t1=$(date +%s.%N)
       sec=$(echo "$t1 - $t0" | bc -l)
       rel=$("$bin" diff "$out" "$ref" | awk '{print $2}')
-      prod=$(echo "$rel * $sec" | bc -l)
+      prod=$(calc "$rel * $sec")
       printf "%-20s guiding %-3s seed %d: relMSE %.5g  %.2f s  relMSE x s %.5g\n" "$name" "$mode" "$r" "$rel" "$sec" "$prod"
       echo "$rel $sec $prod" >> "$dir/$name.$mode"
     done
@@ -64,5 +64,5 @@ for scene in $scenes; do
     eval "r_$mode=$mr"
   done
   printf "%-20s unguided / guided: relMSE %.3fx, relMSE x time %.3fx (> 1: guiding wins)\n" "$name" \
-    "$(echo "$r_off / $r_on" | bc -l)" "$(echo "$p_off / $p_on" | bc -l)"
+    "$(calc "$r_off / $r_on")" "$(calc "$p_off / $p_on")"
 done

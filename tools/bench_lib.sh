@@ -1,5 +1,9 @@
 # bench_lib.sh: shell functions shared by the interleaved A/B benchmark scripts of tools/
-# (bench_mlt.sh, bench_guiding.sh, bench_samples_per_pass.sh). Sourced, not run.
+# (bench_mlt.sh, bench_vegas.sh, bench_guiding.sh, bench_samples_per_pass.sh). Sourced, not run.
+
+# calc EXPR: the arithmetic expression EXPR in awk (bc cannot read numbers printed as 1.5e-05,
+# which small relMSEs are).
+calc() { awk "BEGIN { print $* }"; }
 
 # The median of the numbers on stdin, one per line.
 median() { sort -g | awk '{v[NR] = $1} END {if (NR % 2) print v[(NR + 1) / 2]; else print (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }

@@ -52,7 +52,7 @@ for scene in $scenes; do
       spp=$(attr "$out" spp)
       paths=$(echo "$spp * $([ "$mode" = mlt ] && attr "$out" mltChains || echo "$size * $size")" | bc -l)
       rel=$("$bin" diff "$out" "$ref" | awk '{print $2}')
-      prod=$(echo "$rel * $sec" | bc -l)
+      prod=$(calc "$rel * $sec")
       rate=$(echo "$paths / $sec / 1000000" | bc -l)
       printf "%-14s %-4s seed %d: relMSE %.5g  %.2f s  %.3f Mpaths/s  relMSE x s %.5g\n" "$name" "$mode" "$r" "$rel" "$sec" "$rate" "$prod"
       echo "$rel $sec $prod $rate" >> "$dir/$name.$mode"
@@ -67,5 +67,5 @@ for scene in $scenes; do
       "$name" "$mode" "$rel" "$sec" "$rate" "$prod"
     echo "$prod" > "$dir/$name.$mode.median"
   done
-  printf "%-14s path / mlt (relMSE x s): %.3f\n" "$name" "$(echo "$(cat "$dir/$name.path.median") / $(cat "$dir/$name.mlt.median")" | bc -l)"
+  printf "%-14s path / mlt (relMSE x s): %.3f\n" "$name" "$(calc "$(cat "$dir/$name.path.median") / $(cat "$dir/$name.mlt.median")")"
 done

@@ -273,6 +273,21 @@ STATIC_ASSERT_SIZE(GpuMlt, 96);
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Mlts { GpuMlt v[]; };
 #endif
 
+// A VEGAS render's warp (shaders/shared/vegas.h, src/render/vegas_integrator.cpp).
+// info = (warped axes, bins per axis, primary draws per path, warped bounces);
+// cdf: per axis bins + 1 floats (the axis' CDF, host-written between passes); sums: per axis and
+// bin two uints (the pass's sum of F^2 of the paths whose x fell in the bin, fixed point, low then
+// high word), read and emptied by the host after each pass.
+struct GpuVegas {
+  uvec4 info;
+  BUFREF(Floats) cdf;
+  BUFREF(Uints) sums;
+};
+STATIC_ASSERT_SIZE(GpuVegas, 32);
+#ifndef __cplusplus
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Vegases { GpuVegas v[]; };
+#endif
+
 // Per-render constants and the addresses of every buffer (buffer device addresses: no storage
 // buffer binding limits the size of a scene; lavapipe caps one binding at 128 MiB).
 struct Globals {
@@ -349,12 +364,13 @@ struct Globals {
   BUFREF(GpuGuides) guide;     // one GpuGuide (guiding_layout.h; 0 unless the render is guided)
   BUFREF(Vec2s) primarySamples; // per path primaryDims 2-D draws (PRIMARY_SAMPLES stages only; 0 otherwise)
   BUFREF(Mlts) mlt;            // one GpuMlt of a Metropolis render; 0 otherwise
+  BUFREF(Vegases) vegas;       // one GpuVegas of a VEGAS render; 0 otherwise
   // The top-level acceleration structure's device address, low and high 32 bits, for ray queries
   // (shaders/shared/trace.glsl with NUSSELT_RAY_QUERY); 0 when the GLSL BVH traces.
   uint tlasLow;
   uint tlasHigh;
 };
-STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 39 * 8 + 8);
+STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 40 * 8 + 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 

@@ -21,6 +21,8 @@
 #include "quadtree/sampler_tables.h"
 #include "render/guide.h"
 #include "render/mlt_integrator.h"
+#include "render/vegas_integrator.h"
+#include "../../shaders/shared/vegas.h"
 #include "render/render_loop.h"
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
@@ -57,6 +59,9 @@ struct RenderArgs {
   std::uint32_t mltBootstrap = 0;
   float mltLargeStep = 0.3f;
   float mltSigma = 0.01f;
+  std::uint32_t vegasBins = 64;
+  std::uint32_t vegasBounces = 1;
+  float vegasAlpha = 0.2f;
   std::string guiding = "off";
   std::uint32_t guideTrain = 0;
   double guideMemoryMiB = 16;
@@ -98,11 +103,14 @@ int renderCommand(const RenderArgs& a) {
   parseRouletteMode(a.roulette, s.roulette);
   parseTraversal(a.traversal, s.traversal);
   if (!parseIntegrator(a.integrator, s.integrator))
-    throw Error("--integrator " + a.integrator + ": unknown integrator (path or mlt)");
+    throw Error("--integrator " + a.integrator + ": unknown integrator (path, mlt or vegas)");
   s.mltChains = a.mltChains;
   s.mltBootstrap = a.mltBootstrap;
   s.mltLargeStep = a.mltLargeStep;
   s.mltSigma = a.mltSigma;
+  s.vegasBins = a.vegasBins;
+  s.vegasBounces = a.vegasBounces;
+  s.vegasAlpha = a.vegasAlpha;
   s.guiding = a.guiding == "on";
   s.guideTrainSpp = a.guideTrain;
   s.guideSpatialThreshold = a.guideSpatial;
@@ -118,6 +126,14 @@ int renderCommand(const RenderArgs& a) {
     if (a.variance)
       throw Error("--variance with --integrator mlt: the Metropolis estimate has no per-sample variance (its samples "
                   "are correlated; docs/mlt.md)");
+  }
+  // VEGAS renders (docs/vegas.md): the learned tables live on the host and device only, so a file
+  // cannot continue them (a fresh warp would make a resumed render differ from an uninterrupted one).
+  if (s.integrator == IntegratorKind::Vegas) {
+    if (!a.resume.empty())
+      throw Error("--resume with --integrator vegas: a VEGAS render cannot be resumed (its learned warp is not in the "
+                  "file; docs/vegas.md)");
+    if (s.guiding) throw Error("--integrator vegas with --guiding on: not supported (docs/vegas.md)");
   }
   if (s.guiding && !a.resume.empty())
     throw Error("--resume with --guiding on: a guided render cannot be resumed yet (its guide is not in the file; "
@@ -256,6 +272,16 @@ int renderCommand(const RenderArgs& a) {
                    m.proposals ? 100.0 * double(m.largeProposals) / double(m.proposals) : 0.0,
                    m.largeProposals ? 100.0 * double(m.largeAccepted) / double(m.largeProposals) : 0.0);
     }
+    if (const VegasIntegrator* vegas = renderer.vegas(); vegas && !a.quiet) {
+      const VegasReport& v = vegas->report();
+      std::fprintf(stderr, "vegas: %u axes (%u bounces) of %u bins, %u primary draws per path; %u tables learned from "
+                           "%llu paths in %.3f s; largest density per bounce (light choice, light point x y, bsdf x y):",
+                   v.axes, v.bounces, v.bins, v.dims, v.refinements, static_cast<unsigned long long>(v.learnedPaths),
+                   v.learnSeconds);
+      for (std::uint32_t a = 0; a < v.axes; ++a)
+        std::fprintf(stderr, "%s%.2f", a % VEGAS_AXES_PER_BOUNCE == 0 ? (a ? " | " : " ") : " ", v.maxDensity[a]);
+      std::fprintf(stderr, "\n");
+    }
     if (rec.interrupted)
       std::fprintf(stderr, "interrupted by %s after %u of %u spp: writing what has accumulated\n",
                    g_stopSignal == SIGINT ? "SIGINT" : "SIGTERM", rec.spp, targetSpp);
@@ -300,6 +326,9 @@ int mergeCommand(const std::vector<std::string>& inputs, const std::string& outp
     RenderRecord r = readRecord(inputs[k], meta);
     if (r.settings.integrator == IntegratorKind::Mlt)
       throw Error(inputs[k] + ": rendered with --integrator mlt; merging Metropolis renders is not supported (docs/mlt.md)");
+    if (r.settings.integrator == IntegratorKind::Vegas)
+      throw Error(inputs[k] + ": rendered with --integrator vegas; merging VEGAS renders is not supported (each part "
+                  "learned its own warp: the merge would not be one render of those samples; docs/vegas.md)");
     r.settings.width = static_cast<std::uint32_t>(img.width);
     r.settings.height = static_cast<std::uint32_t>(img.height);
     if (img.sum.empty() || img.sumSq.empty())
@@ -705,8 +734,10 @@ int runCli(int argc, char** argv) {
   render->add_option("--checkpoint", ra.checkpointSeconds, "Write the image so far to the output every this many seconds "
                                                           "(resumable with --resume; 0: never)")
       ->capture_default_str()->check(CLI::Range(0.0, 1e9));
-  render->add_option("--integrator", ra.integrator, "Integrator: path (the wavefront path tracer) or mlt (primary-"
-                                                   "sample-space Metropolis over it; docs/mlt.md)")
+  render->add_option("--integrator", ra.integrator, "Integrator: path (the wavefront path tracer), mlt (primary-"
+                                                   "sample-space Metropolis over it; docs/mlt.md) or vegas (the path "
+                                                   "tracer with a learned separable warp of its first draws; "
+                                                   "docs/vegas.md)")
       ->capture_default_str();
   render->add_option("--mlt-chains", ra.mltChains, "mlt: Markov chains in flight (each a path per mutation)")
       ->capture_default_str()->check(CLI::Range(64u, 4194240u));
@@ -717,6 +748,14 @@ int runCli(int argc, char** argv) {
       ->capture_default_str()->check(CLI::Range(0.0f, 1.0f));
   render->add_option("--mlt-sigma", ra.mltSigma, "mlt: standard deviation of a small step per primary coordinate")
       ->capture_default_str()->check(CLI::Range(1e-6f, 1.0f));
+  render->add_option("--vegas-bins", ra.vegasBins, "vegas: bins of each warped axis's density (1 .. 4096)")
+      ->capture_default_str();
+  render->add_option("--vegas-bounces", ra.vegasBounces, "vegas: bounces whose light choice, light point and BSDF "
+                                                         "draws are warped (1 .. max depth + 1)")
+      ->capture_default_str();
+  render->add_option("--vegas-alpha", ra.vegasAlpha, "vegas: share of the uniform density in each learned one "
+                                                     "(0.01 .. 1; keeps every bin's density >= alpha)")
+      ->capture_default_str();
   render->add_option("--guiding", ra.guiding, "Path guiding (docs/guiding.md): on = sample directions from a guide "
                                               "learned from the render's first samples (one-sample MIS with the BSDF "
                                               "sampler), off = BSDF sampling only")

@@ -309,6 +309,14 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, b
   mark(cmd, "accumulate");
 }
 
+void PathIntegrator::recordAccumulate(VkCommandBuffer cmd, std::uint32_t paths) {
+  BounceConstants pc{};
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_accumulate.pipeline);
+  vkCmdPushConstants(cmd, m_globals.layout(), VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
+  vkCmdDispatch(cmd, (paths + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE, 1, 1);
+  vk::computeBarrier(cmd);
+}
+
 void PathIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples) {
   samples = std::max(1u, samples);
   const std::uint64_t paths = m_pixels * samples;

@@ -58,11 +58,14 @@ class PathIntegrator : public Integrator {
   static std::uint32_t primaryDimsFor(std::uint32_t maxDepth);
 
   void renderPass(std::uint32_t sampleIndex, std::uint32_t samples) override;
-  // For integrators that drive the path tracer (mlt): records the tracing of path slots
+  // For integrators that drive the path tracer (mlt, vegas): records the tracing of path slots
   // 0 .. paths - 1 (camera and bounces, no accumulation into the film) into cmd, with the globals
   // the caller uploaded (chunkFirst 0, chunkPaths = paths, passSamples 1); after the submission
   // has completed, foldStats() adds its counters to stats().
   void recordTrace(VkCommandBuffer cmd, std::uint32_t paths) { recordPass(cmd, paths, false); }
+  // For integrators that weigh the traced paths before they reach the film (vegas): records the
+  // accumulate stage over path slots 0 .. paths - 1 of the chunk the globals describe.
+  void recordAccumulate(VkCommandBuffer cmd, std::uint32_t paths);
   void foldStats();
   RenderStats stats() const override { return m_totals; }
   void addStats(const RenderStats& carried) override;

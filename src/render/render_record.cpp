@@ -118,9 +118,18 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
       meta.doubles.push_back({"nusselt/mltLargeStep", r.settings.mltLargeStep});
       meta.doubles.push_back({"nusselt/mltSigma", r.settings.mltSigma});
     }
+    if (r.settings.integrator == IntegratorKind::Vegas) {
+      meta.ints.push_back({"nusselt/vegasBins", r.settings.vegasBins});
+      meta.ints.push_back({"nusselt/vegasBounces", r.settings.vegasBounces});
+      meta.doubles.push_back({"nusselt/vegasAlpha", r.settings.vegasAlpha});
+    }
+    const bool mlt = r.settings.integrator == IntegratorKind::Mlt;
     for (auto& [name, value] : meta.strings)
       if (name == "nusselt/integrator")
-        value = "primary-sample-space Metropolis (PSSMLT) over the wavefront path tracer (" + value + ")";
+        value = (mlt ? "primary-sample-space Metropolis (PSSMLT) over the wavefront path tracer ("
+                     : "VEGAS (separable warp of the first bounces' primary draws, learned per pass) over the "
+                       "wavefront path tracer (") +
+                value + ")";
   }
   if (r.source == "preview") meta.doubles.push_back({"nusselt/exposure", r.displayExposure});
   return meta;
@@ -193,6 +202,11 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
     r.settings.mltBootstrap = static_cast<std::uint32_t>(findInt(meta, "nusselt/mltBootstrap").value_or(0));
     r.settings.mltLargeStep = static_cast<float>(findDouble(meta, "nusselt/mltLargeStep").value_or(0.3));
     r.settings.mltSigma = static_cast<float>(findDouble(meta, "nusselt/mltSigma").value_or(0.01));
+  }
+  if (r.settings.integrator == IntegratorKind::Vegas) {
+    r.settings.vegasBins = static_cast<std::uint32_t>(findInt(meta, "nusselt/vegasBins").value_or(64));
+    r.settings.vegasBounces = static_cast<std::uint32_t>(findInt(meta, "nusselt/vegasBounces").value_or(1));
+    r.settings.vegasAlpha = static_cast<float>(findDouble(meta, "nusselt/vegasAlpha").value_or(0.2));
   }
   // Absent in unguided renders (and files written before guiding existed).
   r.settings.guiding = findString(meta, "nusselt/guiding").value_or("off") == "on";

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <set>
@@ -15,6 +16,8 @@
 #include "render/mlt_integrator.h"
 #include "render/path_integrator.h"
 #include "render/texture_table.h"
+#include "render/vegas_integrator.h"
+#include "../../shaders/shared/vegas.h"
 #include "util/error.h"
 
 namespace nusselt {
@@ -61,6 +64,21 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   if (mlt && (settings.mltChains == 0 || settings.mltChains > 65535u * WORKGROUP_SIZE))
     throw Error("--mlt-chains " + std::to_string(settings.mltChains) + ": between 1 and " +
                 std::to_string(65535u * WORKGROUP_SIZE));
+  const bool vegas = settings.integrator == IntegratorKind::Vegas;
+  if (vegas) {
+    if (settings.guiding) throw Error("--integrator vegas with --guiding on: not supported (docs/vegas.md)");
+    if (settings.vegasBins == 0 || settings.vegasBins > 4096)
+      throw Error("--vegas-bins " + std::to_string(settings.vegasBins) + ": between 1 and 4096");
+    if (settings.vegasBounces == 0 || settings.vegasBounces > settings.maxDepth + 1)
+      throw Error("--vegas-bounces " + std::to_string(settings.vegasBounces) + ": between 1 and max depth + 1 (" +
+                  std::to_string(settings.maxDepth + 1) + ")");
+    if (!(settings.vegasAlpha >= 0.01f && settings.vegasAlpha <= 1.0f)) {
+      char value[32];
+      std::snprintf(value, sizeof value, "%g", double(settings.vegasAlpha));
+      throw Error(std::string("--vegas-alpha ") + value +
+                  ": between 0.01 and 1 (the uniform share that keeps every bin's density > 0)");
+    }
+  }
   m_settings.traversal = resolveTraversal(ctx, settings.traversal);
   m_summary.traversal = m_settings.traversal;
   const std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;
@@ -77,8 +95,9 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
                            : PathIntegrator::samplesPerPassFor(settings, pixels,
                                                                m_ctx.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
     const std::uint32_t capacity = mlt ? settings.mltChains : PathIntegrator::capacityFor(settings, pixels, m_samplesPerPass);
-    const std::uint32_t primaryDims =
-        settings.primarySamples || mlt ? PathIntegrator::primaryDimsFor(settings.maxDepth) : 0;
+    const std::uint32_t primaryDims = settings.primarySamples || mlt ? PathIntegrator::primaryDimsFor(settings.maxDepth)
+                                      : vegas                        ? shared::vegasPrimaryDims(settings.vegasBounces)
+                                                                     : 0;
     auto mib = [](std::uint64_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
     const std::uint64_t envBytes = environmentBytes(effectiveEnvironment(scene));
     if (m_ctx.maxAllocation && envBytes > m_ctx.maxAllocation)
@@ -99,6 +118,7 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
                                Film::bytesFor(pixels) +
                                PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS, primaryDims) +
                                (mlt ? MltIntegrator::bytesFor(capacity, primaryDims, mltBootstrapPaths(settings), pixels) : 0) +
+                               (vegas ? VegasIntegrator::bytesFor(settings) : 0) +
                                (settings.guiding ? DeviceGuide::bytesFor(settings.guideMemory, capacity, settings.maxDepth) : 0);
     const std::uint64_t have = vk::deviceLocalHeapSize(m_ctx);
     // The film is the largest single buffer (16 bytes per pixel, twice): one allocation each.
@@ -170,6 +190,7 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   }
   PathOptions paths;
   if (settings.primarySamples || mlt) paths.primaryDims = PathIntegrator::primaryDimsFor(settings.maxDepth);
+  else if (vegas) paths.primaryDims = shared::vegasPrimaryDims(settings.vegasBounces);
   if (mlt) {
     paths.imageSamples = true;
     paths.capacity = settings.mltChains;
@@ -182,6 +203,10 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
     auto chains = std::make_unique<MltIntegrator>(m_ctx, *m_globals, m_settings, std::move(integrator), pixels);
     m_mlt = chains.get();
     m_integrator = std::move(chains);
+  } else if (vegas) {
+    auto warped = std::make_unique<VegasIntegrator>(m_ctx, *m_globals, m_settings, std::move(integrator), pixels);
+    m_vegas = warped.get();
+    m_integrator = std::move(warped);
   } else {
     m_integrator = std::move(integrator);
   }

@@ -51,6 +51,7 @@ Traversal resolveTraversal(const vk::Context& ctx, Traversal requested);
 class DeviceGuide;
 class PathIntegrator;
 class MltIntegrator;
+class VegasIntegrator;
 
 class Renderer {
  public:
@@ -96,6 +97,8 @@ class Renderer {
   PathIntegrator& paths() { return *m_paths; }
   // The Metropolis integrator of an mlt render (its chains' report), null otherwise.
   const MltIntegrator* mlt() const { return m_mlt; }
+  // The VEGAS integrator of a vegas render (its warp's report), null otherwise.
+  const VegasIntegrator* vegas() const { return m_vegas; }
 
   // ---- Progressive use (the preview window) ----
   // Restart accumulation: the film is cleared and the sample index goes back to 0.
@@ -130,6 +133,7 @@ class Renderer {
   std::unique_ptr<Integrator> m_integrator;
   PathIntegrator* m_paths = nullptr;  // m_integrator's path tracer
   MltIntegrator* m_mlt = nullptr;     // m_integrator when it is Metropolis
+  VegasIntegrator* m_vegas = nullptr; // m_integrator when it is VEGAS
 };
 
 }  // namespace nusselt

@@ -93,10 +93,11 @@ inline constexpr EnumName<Traversal> kTraversalNames[] = {
     {Traversal::Auto, "auto"}, {Traversal::RayQuery, "rayquery"}, {Traversal::Bvh, "bvh"}};
 
 // The integrator of a render (`--integrator`): path = the wavefront path tracer; mlt = primary
-// sample space Metropolis light transport over it (issue 19, docs/mlt.md). Not a shader value.
-enum class IntegratorKind : std::uint32_t { Path, Mlt };
-inline constexpr EnumName<IntegratorKind> kIntegratorNames[] = {{IntegratorKind::Path, "path"},
-                                                                {IntegratorKind::Mlt, "mlt"}};
+// sample space Metropolis light transport over it (issue 19, docs/mlt.md); vegas = the path tracer
+// with VEGAS's learned separable warp of its first draws (docs/vegas.md). Not a shader value.
+enum class IntegratorKind : std::uint32_t { Path, Mlt, Vegas };
+inline constexpr EnumName<IntegratorKind> kIntegratorNames[] = {
+    {IntegratorKind::Path, "path"}, {IntegratorKind::Mlt, "mlt"}, {IntegratorKind::Vegas, "vegas"}};
 
 inline const char* lightingModeName(LightingMode m) { return enumName(kLightingNames, m); }
 inline const char* samplerName(SamplerKind k) { return enumName(kSamplerNames, k); }
@@ -176,6 +177,14 @@ struct RenderSettings {
   float mltLargeStep = 0.3f;
   // Standard deviation of a small step's move per coordinate (`--mlt-sigma`; pbrt: 0.01).
   float mltSigma = 0.01f;
+  // VEGAS (--integrator vegas, docs/vegas.md). Bins per warped axis (`--vegas-bins`, 1 .. 4096).
+  std::uint32_t vegasBins = 64;
+  // Bounces whose light choice, light point and BSDF draws are warped (`--vegas-bounces`, 1 ..
+  // max depth + 1; 5 axes each). 1: bounce 1's axes learned little and cost throughput (docs/vegas.md).
+  std::uint32_t vegasBounces = 1;
+  // Weight of the uniform density in every learned one (`--vegas-alpha`, 0.01 .. 1; 1: no warp):
+  // every bin keeps a density >= alpha, so the estimate stays unbiased and 1 / p_a <= 1 / alpha.
+  float vegasAlpha = 0.2f;
 };
 
 // The bootstrap paths of a Metropolis render (RenderSettings::mltBootstrap resolved).

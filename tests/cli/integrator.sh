@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # --integrator: path is the default and leaves the header as before (no nusselt/integratorName);
-# an unknown name and the combinations Metropolis renders do not support are refused with a
+# an unknown name and the combinations Metropolis and VEGAS renders do not support are refused with a
 # message that says why, a failure status and no output file.
 # Usage: integrator.sh NUSSELT SOURCE_DIR
 set -u
@@ -44,6 +44,29 @@ cp "$work/mlt.exr" "$work/resume.exr"
 if "$nusselt" render "${small[@]}" --resume "$work/resume.exr" --spp 4 2>"$work/err"; then fail "path resume of an mlt render"
 elif ! grep -qF "integrator" "$work/err"; then fail "resume message: $(cat "$work/err")"
 else echo "ok   mlt_resume_as_path: $(cat "$work/err")"; fi
+
+# vegas: bad options and unsupported combinations are refused; its header names it and its
+# options; merging and resuming it (as vegas or as path) are refused.
+expect_error vegas_bins "--vegas-bins 0: between 1 and 4096" -- --integrator vegas --vegas-bins 0
+expect_error vegas_bounces "--vegas-bounces 0" -- --integrator vegas --vegas-bounces 0
+expect_error vegas_bounces_depth "max depth + 1" -- --integrator vegas --vegas-bounces 4 --max-depth 2
+expect_error vegas_alpha "--vegas-alpha" -- --integrator vegas --vegas-alpha 0
+expect_error vegas_guiding "not supported" -- --integrator vegas --guiding on
+expect_error vegas_resume "cannot be resumed" -- --integrator vegas --resume "$work/path.exr" --spp 2
+"$nusselt" render -o "$work/vegas.exr" "${small[@]}" --integrator vegas --spp 4 --samples-per-pass 2 --vegas-bins 16 \
+  --variance || fail "vegas render"
+[ "$("$nusselt" info "$work/vegas.exr" | sed -n 's/^  nusselt\/integratorName: //p')" = vegas ] || fail "vegas header"
+[ "$("$nusselt" info "$work/vegas.exr" | sed -n 's/^  nusselt\/vegasBins: //p')" = 16 ] || fail "vegas bins in the header"
+"$nusselt" render -o "$work/vegas2.exr" "${small[@]}" --integrator vegas --spp 2 --spp-offset 4 || fail "vegas render 2"
+if "$nusselt" merge "$work/vegas.exr" "$work/vegas2.exr" -o "$work/merged.exr" 2>"$work/err"; then fail "merge of vegas renders"
+elif ! grep -qF "merging VEGAS renders is not supported" "$work/err"; then fail "merge message: $(cat "$work/err")"
+else echo "ok   vegas_merge: $(cat "$work/err")"; fi
+if "$nusselt" merge "$work/path.exr" "$work/vegas2.exr" -o "$work/merged.exr" 2>"$work/err"; then fail "merge of path and vegas"
+else echo "ok   vegas_merge_with_path: $(cat "$work/err")"; fi
+cp "$work/vegas.exr" "$work/resume.exr"
+if "$nusselt" render "${small[@]}" --resume "$work/resume.exr" --spp 8 2>"$work/err"; then fail "path resume of a vegas render"
+elif ! grep -qF "integrator" "$work/err"; then fail "resume message: $(cat "$work/err")"
+else echo "ok   vegas_resume_as_path: $(cat "$work/err")"; fi
 
 [ $fails -eq 0 ] && echo "all integrator checks passed"
 exit $((fails > 0))

@@ -34,48 +34,6 @@ RenderSettings mltSettings(std::uint32_t seed, std::uint32_t chains, std::uint32
   return s;
 }
 
-constexpr int kBlock = 4;  // blocks of 4 x 4 pixels: 16 blocks of the 16 x 16 image
-
-// Mean luminance of every block (and its variance of the mean from the per-pixel variances, for
-// the path tracer's independent pixels), then the whole image last.
-void blockMeans(const Image& img, std::vector<double>& mean, std::vector<double>* var) {
-  const int bw = img.width / kBlock, bh = img.height / kBlock, blocks = bw * bh;
-  mean.assign(blocks + 1, 0.0);
-  if (var) var->assign(blocks + 1, 0.0);
-  const double w[3] = {0.2126, 0.7152, 0.0722};
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) {
-      const std::size_t p = std::size_t(y) * img.width + x;
-      const int b = (y / kBlock) * bw + x / kBlock;
-      for (int c = 0; c < 3; ++c) {
-        mean[b] += w[c] * img.rgb[3 * p + c] / (kBlock * kBlock);
-        mean[blocks] += w[c] * img.rgb[3 * p + c] / (img.width * img.height);
-      }
-      // Channels of one pixel are correlated: the luminance's variance is bounded by (sum w sd)^2.
-      if (var) {
-        double sd = 0;
-        for (int c = 0; c < 3; ++c) sd += w[c] * std::sqrt(std::max(0.0f, img.variance[3 * p + c]));
-        (*var)[b] += sd * sd / double(kBlock * kBlock * kBlock * kBlock);
-        (*var)[blocks] += sd * sd / (double(img.width) * img.height * img.width * img.height);
-      }
-    }
-}
-
-// Upper tail P(T > t) of Student's t with nu degrees of freedom (Simpson's rule on t = tan theta).
-double studentTail(double t, double nu) {
-  const double c = std::exp(std::lgamma(0.5 * (nu + 1)) - std::lgamma(0.5 * nu)) / std::sqrt(nu * M_PI);
-  const double a = std::atan(t), b = 0.5 * M_PI;
-  const int n = 20000;
-  auto f = [&](double th) {
-    if (th >= b) return 0.0;
-    const double x = std::tan(th), s = 1.0 / std::cos(th);
-    return c * std::pow(1 + x * x / nu, -0.5 * (nu + 1)) * s * s;
-  };
-  double sum = f(a) + f(b);
-  for (int i = 1; i < n; ++i) sum += f(a + (b - a) * i / n) * (i % 2 ? 4 : 2);
-  return sum * (b - a) / (3 * n);
-}
-
 // Mean of `seeds` Metropolis renders against a path-traced reference, per block and for the
 // whole image: Welch-style t with the seeds' sample variance (the only honest variance of a
 // correlated estimate) plus the reference's; each test two-sided at 0.001 / tests (Bonferroni).
@@ -87,7 +45,7 @@ void expectMltMatchesPath(std::uint32_t chains, std::uint32_t iterations, int se
   ps.spp = 8192;
   test::Rendered ref = test::render(scene, ps);
   std::vector<double> refMean, refVar;
-  blockMeans(ref.image, refMean, &refVar);
+  test::blockMeans(ref.image, refMean, &refVar);
   const std::size_t tests = refMean.size();
   std::vector<double> sum(tests, 0.0), sumSq(tests, 0.0);
   for (int k = 0; k < seeds; ++k) {
@@ -96,14 +54,14 @@ void expectMltMatchesPath(std::uint32_t chains, std::uint32_t iterations, int se
     test::Rendered r = test::render(scene, ms);
     EXPECT_EQ(r.stats.nonFiniteSamples, 0u);
     std::vector<double> m;
-    blockMeans(r.image, m, nullptr);
+    test::blockMeans(r.image, m, nullptr);
     for (std::size_t b = 0; b < tests; ++b) sum[b] += m[b], sumSq[b] += m[b] * m[b];
   }
   const double alpha = 0.001 / double(tests), n = seeds;
   for (std::size_t b = 0; b < tests; ++b) {
     const double mean = sum[b] / n, s2 = std::max(0.0, (sumSq[b] - n * mean * mean) / (n - 1));
     const double t = (mean - refMean[b]) / std::sqrt(s2 / n + refVar[b]);
-    const double p = 2 * studentTail(std::abs(t), n - 1);
+    const double p = 2 * test::studentTail(std::abs(t), n - 1);
     if (b + 1 == tests)
       std::printf("%u chains x %u mutations, %d seeds: image luminance mlt %.5f +- %.5f, path %.5f +- %.5f (t %.2f)\n",
                   chains, iterations, seeds, mean, std::sqrt(s2 / n), refMean[b], std::sqrt(refVar[b]), t);
@@ -118,8 +76,8 @@ void expectMltMatchesPath(std::uint32_t chains, std::uint32_t iterations, int se
 
 TEST(Mlt, StudentTailIsRight) {
   // Known quantiles: t(7) upper 0.025 at 2.3646, t(5) upper 0.0005 at 6.8688.
-  EXPECT_NEAR(studentTail(2.3646, 7), 0.025, 1e-4);
-  EXPECT_NEAR(studentTail(6.8688, 5), 0.0005, 1e-5);
+  EXPECT_NEAR(test::studentTail(2.3646, 7), 0.025, 1e-4);
+  EXPECT_NEAR(test::studentTail(6.8688, 5), 0.0005, 1e-5);
 }
 
 // Chains of 10 mutations: what is left of start-up bias would show here.

@@ -81,6 +81,45 @@ Rendered render(const Scene& scene, const RenderSettings& settings) {
   return {r.image(true), r.stats(), r.summary()};
 }
 
+void blockMeans(const Image& img, std::vector<double>& mean, std::vector<double>* var) {
+  constexpr int kBlock = 4;  // blocks of 4 x 4 pixels: 16 blocks of a 16 x 16 image
+  const int bw = img.width / kBlock, bh = img.height / kBlock, blocks = bw * bh;
+  mean.assign(blocks + 1, 0.0);
+  if (var) var->assign(blocks + 1, 0.0);
+  const double w[3] = {0.2126, 0.7152, 0.0722};
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const std::size_t p = std::size_t(y) * img.width + x;
+      const int b = (y / kBlock) * bw + x / kBlock;
+      for (int c = 0; c < 3; ++c) {
+        mean[b] += w[c] * img.rgb[3 * p + c] / (kBlock * kBlock);
+        mean[blocks] += w[c] * img.rgb[3 * p + c] / (img.width * img.height);
+      }
+      // Channels of one pixel are correlated: the luminance's variance is bounded by (sum w sd)^2.
+      if (var) {
+        double sd = 0;
+        for (int c = 0; c < 3; ++c) sd += w[c] * std::sqrt(std::max(0.0f, img.variance[3 * p + c]));
+        (*var)[b] += sd * sd / double(kBlock * kBlock * kBlock * kBlock);
+        (*var)[blocks] += sd * sd / (double(img.width) * img.height * img.width * img.height);
+      }
+    }
+}
+
+// Simpson's rule on t = tan theta.
+double studentTail(double t, double nu) {
+  const double c = std::exp(std::lgamma(0.5 * (nu + 1)) - std::lgamma(0.5 * nu)) / std::sqrt(nu * M_PI);
+  const double a = std::atan(t), b = 0.5 * M_PI;
+  const int n = 20000;
+  auto f = [&](double th) {
+    if (th >= b) return 0.0;
+    const double x = std::tan(th), s = 1.0 / std::cos(th);
+    return c * std::pow(1 + x * x / nu, -0.5 * (nu + 1)) * s * s;
+  };
+  double sum = f(a) + f(b);
+  for (int i = 1; i < n; ++i) sum += f(a + (b - a) * i / n) * (i % 2 ? 4 : 2);
+  return sum * (b - a) / (3 * n);
+}
+
 BrdfParityKernel::BrdfParityKernel(std::vector<std::pair<glm::vec3, glm::vec3>> pairs, std::uint64_t measured)
     : m_pairs(std::move(pairs)), m_measured(measured) {
   vk::Context& ctx = context();

@@ -35,6 +35,13 @@ struct Rendered {
 // (rayquery or bvh) when that is set.
 Rendered render(const Scene& scene, const RenderSettings& settings);
 
+// Mean luminance of every 4 x 4 block of img (width and height multiples of 4) and, when var is
+// given, its variance of the mean from the per-pixel variances (the path tracer's independent
+// pixels); the whole image's last. (Integrators against the path tracer: test_mlt, test_vegas.)
+void blockMeans(const Image& img, std::vector<double>& mean, std::vector<double>* var);
+// Upper tail P(T > t) of Student's t with nu degrees of freedom.
+double studentTail(double t, double nu);
+
 // Runs an embedded standalone compute kernel (one that declares its own push-constant block of at
 // most 128 bytes, typically buffer device addresses, and no descriptor sets) over `invocations`
 // threads, with the given specialization constants, and waits for it.

@@ -1,0 +1,193 @@
+// vegas_integrator.cpp: the warp's buffers, the weighted passes and the learning (vegas_integrator.h).
+#include "render/vegas_integrator.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "../../shaders/shared/layout.h"
+#include "../../shaders/shared/vegas.h"
+#include "util/error.h"
+
+namespace nusselt {
+
+using shared::GpuVegas;
+using shared::Globals;
+
+void vegasUniformCdf(float* cdf, std::uint32_t bins) {
+  for (std::uint32_t i = 0; i <= bins; ++i) cdf[i] = static_cast<float>(double(i) / double(bins));
+}
+
+void vegasRefine(std::vector<double>& G, float* cdf, std::uint32_t bins, const double* S, double n, double alpha) {
+  if (n <= 0) return;
+  for (std::uint32_t b = 0; b < bins; ++b) {
+    const double p = (double(cdf[b + 1]) - double(cdf[b])) * double(bins);  // the pass's density in bin b
+    G[b] += p * S[b] / n;
+  }
+  // Classic VEGAS's smoothing: each bin's estimate averaged with its neighbours' (one bin's
+  // noise, a firefly's F^2, spreads over three), then the square root.
+  std::vector<double> q(bins);
+  double mean = 0;
+  for (std::uint32_t b = 0; b < bins; ++b) {
+    const std::uint32_t lo = b > 0 ? b - 1 : b, hi = b + 1 < bins ? b + 1 : b;
+    double sum = 0;
+    for (std::uint32_t c = lo; c <= hi; ++c) sum += G[c];
+    q[b] = std::sqrt(sum / double(hi - lo + 1));
+    mean += q[b];
+  }
+  mean /= double(bins);
+  if (!(mean > 0) || !std::isfinite(mean)) {
+    vegasUniformCdf(cdf, bins);
+    return;
+  }
+  // Cumulative masses (1 / bins of the density each) in double, rounded to float once.
+  double acc = 0;
+  cdf[0] = 0.0f;
+  for (std::uint32_t b = 0; b < bins; ++b) {
+    const double p = (1.0 - alpha) * q[b] / mean + alpha;
+    acc += p / double(bins);
+    cdf[b + 1] = static_cast<float>(acc);
+  }
+  cdf[bins] = 1.0f;
+  for (std::uint32_t b = 0; b < bins; ++b)
+    if (!(cdf[b + 1] > cdf[b])) throw Error("vegas: a bin of the learned density lost its mass in float (bins or alpha)");
+}
+
+std::uint64_t VegasIntegrator::bytesFor(const RenderSettings& s) {
+  const std::uint64_t axes = std::uint64_t(s.vegasBounces) * VEGAS_AXES_PER_BOUNCE;
+  return axes * (s.vegasBins + 1) * 4 + axes * s.vegasBins * 8 + sizeof(GpuVegas);
+}
+
+VegasIntegrator::VegasIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
+                                 std::unique_ptr<PathIntegrator> paths, std::uint64_t pixels)
+    : m_ctx(ctx), m_globals(globals), m_settings(settings), m_paths(std::move(paths)), m_pixels(pixels) {
+  const std::uint32_t dims = globals.host().primaryDims;
+  if (dims != shared::vegasPrimaryDims(settings.vegasBounces))
+    throw Error("vegas: the path tracer's primary draws do not cover the warped bounces");
+  m_axes = settings.vegasBounces * VEGAS_AXES_PER_BOUNCE;
+  m_bins = settings.vegasBins;
+  m_report.axes = m_axes;
+  m_report.bins = m_bins;
+  m_report.bounces = settings.vegasBounces;
+  m_report.dims = dims;
+  m_report.maxDensity.assign(m_axes, 1.0f);
+  m_G.assign(m_axes, std::vector<double>(m_bins, 0.0));
+  m_buffers.reserve(4);
+  auto make = [&](VkDeviceSize bytes, const std::string& what) -> vk::Buffer* {
+    m_buffers.push_back(vk::createBuffer(m_ctx, bytes, 0, true, what));
+    return &m_buffers.back();
+  };
+  m_vegas = make(sizeof(GpuVegas), "vegas state");
+  m_cdf = make(std::uint64_t(m_axes) * (m_bins + 1) * 4, "vegas tables");
+  m_sums = make(std::uint64_t(m_axes) * m_bins * 8, "vegas bin sums");
+  float* cdf = static_cast<float*>(m_cdf->mapped);
+  for (std::uint32_t a = 0; a < m_axes; ++a) vegasUniformCdf(cdf + std::size_t(a) * (m_bins + 1), m_bins);
+  std::memset(m_sums->mapped, 0, std::size_t(m_axes) * m_bins * 8);
+  GpuVegas& v = *static_cast<GpuVegas*>(m_vegas->mapped);
+  v = GpuVegas{};
+  v.info = {m_axes, m_bins, dims, settings.vegasBounces};
+  v.cdf = m_cdf->address;
+  v.sums = m_sums->address;
+  globals.host().vegas = m_vegas->address;
+
+  for (std::uint32_t k = 0; k <= VEGAS_KERNEL_WEIGH; ++k) {
+    std::vector<std::uint32_t> spec(14, 0u);
+    spec[13] = k;  // constant 13: VEGAS_KERNEL
+    m_kernels.push_back(vk::createComputePipeline(m_ctx, globals.layout(), "vegas", spec));
+  }
+  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  ai.commandPool = m_ctx.commandPool;
+  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  ai.commandBufferCount = 1;
+  VK_CHECK(vkAllocateCommandBuffers(m_ctx.device, &ai, &m_cmd));
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VK_CHECK(vkCreateFence(m_ctx.device, &fci, nullptr, &m_fence));
+}
+
+VegasIntegrator::~VegasIntegrator() {
+  VkDevice d = m_ctx.device;
+  vkDeviceWaitIdle(d);
+  if (m_fence) vkDestroyFence(d, m_fence, nullptr);
+  if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
+  for (auto& p : m_kernels) vk::destroyComputePipeline(m_ctx, p);
+  for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
+}
+
+std::uint64_t VegasIntegrator::deviceBytes() const {
+  std::uint64_t total = m_paths->deviceBytes();
+  for (const vk::Buffer& b : m_buffers) total += b.size;
+  return total;
+}
+
+std::vector<float> VegasIntegrator::cdf(std::uint32_t axis) const {
+  const float* c = static_cast<const float*>(m_cdf->mapped) + std::size_t(axis) * (m_bins + 1);
+  return std::vector<float>(c, c + m_bins + 1);
+}
+
+void VegasIntegrator::dispatch(VkCommandBuffer cmd, std::uint32_t kernel, std::uint32_t n) {
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_kernels[kernel].pipeline);
+  vkCmdDispatch(cmd, (n + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE, 1, 1);
+  vk::computeBarrier(cmd);
+}
+
+void VegasIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples) {
+  samples = std::max(1u, samples);
+  const std::uint64_t paths = m_pixels * samples;
+  if (paths > 0xffffffffull) throw Error("a pass of " + std::to_string(samples) + " samples per pixel has too many paths");
+  const std::uint32_t capacity = m_paths->capacity();
+  for (std::uint64_t start = 0; start < paths; start += capacity) {
+    const std::uint32_t count = static_cast<std::uint32_t>(std::min<std::uint64_t>(capacity, paths - start));
+    Globals& g = m_globals.host();
+    g.chunkFirst = static_cast<std::uint32_t>(start);
+    g.chunkPaths = count;
+    g.sampleIndex = sampleIndex;
+    g.passSamples = samples;
+    m_globals.upload();
+
+    VK_CHECK(vkResetCommandBuffer(m_cmd, 0));
+    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    VK_CHECK(vkBeginCommandBuffer(m_cmd, &bi));
+    const VkDescriptorSet set = m_globals.set();
+    vkCmdBindDescriptorSets(m_cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_globals.layout(), 0, 1, &set, 0, nullptr);
+    dispatch(m_cmd, VEGAS_KERNEL_WARP, count);
+    m_paths->recordTrace(m_cmd, count);
+    vk::computeBarrier(m_cmd);
+    dispatch(m_cmd, VEGAS_KERNEL_WEIGH, count);
+    m_paths->recordAccumulate(m_cmd, count);
+    VK_CHECK(vkEndCommandBuffer(m_cmd));
+    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &m_cmd;
+    VK_CHECK(vkResetFences(m_ctx.device, 1, &m_fence));
+    VK_CHECK(vkQueueSubmit(m_ctx.queue, 1, &si, m_fence));
+    VK_CHECK(vkWaitForFences(m_ctx.device, 1, &m_fence, VK_TRUE, UINT64_MAX));
+    m_paths->foldStats();
+  }
+  learn(paths);
+}
+
+void VegasIntegrator::learn(std::uint64_t paths) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::uint32_t* sums = static_cast<std::uint32_t*>(m_sums->mapped);
+  float* cdf = static_cast<float*>(m_cdf->mapped);
+  std::vector<double> S(m_bins);
+  for (std::uint32_t a = 0; a < m_axes; ++a) {
+    for (std::uint32_t b = 0; b < m_bins; ++b) {
+      const std::uint32_t* s = sums + (std::size_t(a) * m_bins + b) * 2;
+      S[b] = (double(s[1]) * 4294967296.0 + double(s[0])) / double(VEGAS_FIXED_SCALE);
+    }
+    float* c = cdf + std::size_t(a) * (m_bins + 1);
+    vegasRefine(m_G[a], c, m_bins, S.data(), double(paths), m_settings.vegasAlpha);
+    float top = 0;
+    for (std::uint32_t b = 0; b < m_bins; ++b) top = std::max(top, (c[b + 1] - c[b]) * float(m_bins));
+    m_report.maxDensity[a] = top;
+  }
+  std::memset(sums, 0, std::size_t(m_axes) * m_bins * 8);
+  ++m_report.refinements;
+  m_report.learnedPaths += paths;
+  m_report.learnSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace nusselt
