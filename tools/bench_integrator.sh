@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# An integrator (--integrator mlt, docs/mlt.md; --integrator vegas, docs/vegas.md) against the
+# path tracer at equal time: for each scene, a converged path-traced reference (rendered once, kept
+# in DIR), then REPEATS interleaved pairs (path, the integrator; seeds 1, 2, ...), each with the
+# same time budget (--time), compared with the reference (relMSE from `nusselt diff`). Prints per
+# run and the medians: relMSE, the render's sampling seconds (header nusselt/renderSeconds; a
+# budget ends at a pass boundary, so the times differ a little), paths per second (mlt: mutations,
+# the bootstrap excluded), relMSE x seconds (lower is better: the error at equal time for an error
+# falling as 1 / time), relMSE x spp (the error per sample, throughput aside; an mlt render's spp
+# counts mutations per chain), and the ratio
+# path / integrator of the medians' relMSE x s (> 1: the integrator wins). The reference's own
+# noise adds the same amount to both relMSEs (give REF_SPP ~10x what a run reaches).
+#
+#   tools/bench_integrator.sh mlt|vegas [DIR] [NUSSELT]
+# tools/bench_mlt.sh and tools/bench_vegas.sh call it with their integrator's default scenes.
+# Environment: SIZE (default 128), TIME (10 s), REF_SPP (2048), REPEATS (3), DEPTH (8),
+#   SCENES (default: the default Cornell box "default"), ARGS (extra options of the integrator's
+#   renders, e.g. "--mlt-chains 32768" or "--vegas-bins 16").
+set -euo pipefail
+cd "$(dirname "$0")/.."
+integrator=${1:?usage: tools/bench_integrator.sh mlt|vegas [DIR] [NUSSELT]}
+case $integrator in mlt|vegas) ;; *) echo "unknown integrator '$integrator' (mlt or vegas)" >&2; exit 2 ;; esac
+dir=${2:-/tmp/nusselt-bench-$integrator}
+bin=${3:-build/nusselt}
+[ -x "$bin" ] || { echo "no binary $bin: build first" >&2; exit 2; }
+size=${SIZE:-128}
+budget=${TIME:-10}
+refSpp=${REF_SPP:-2048}
+repeats=${REPEATS:-3}
+depth=${DEPTH:-8}
+scenes=${SCENES:-default}
+mkdir -p "$dir"
+common="--width $size --height $size --max-depth $depth -q --checkpoint 0"
+
+# shellcheck source=tools/bench_lib.sh
+source tools/bench_lib.sh
+attr() { "$bin" info "$1" | sed -n "s/^  nusselt\/$2: //p" | head -1; }
+
+echo "bench_integrator: $integrator against path, ${size}x${size}, --time $budget per run, reference $refSpp spp (path)," \
+     "max depth $depth, $repeats repeats, $integrator with: ${ARGS:-(defaults)}"
+echo "device: $("$bin" devices | head -1)"
+for scene in $scenes; do
+  name=$(scene_name "$scene")
+  sceneArg=$(scene_arg "$scene")
+  ref="$dir/$name-ref-$size-$refSpp-$depth.exr"
+  # shellcheck disable=SC2086
+  bench_reference "$bin" "$scene" "$ref" "$refSpp" $common
+  for mode in path "$integrator"; do : > "$dir/$name.$mode"; done
+  for ((r = 1; r <= repeats; r++)); do
+    for mode in path "$integrator"; do
+      out="$dir/$name-$mode-$r.exr"
+      extra=""
+      [ "$mode" != path ] && extra=${ARGS:-}
+      # shellcheck disable=SC2086
+      "$bin" render $sceneArg $common --time "$budget" --seed "$r" --integrator "$mode" $extra -o "$out"
+      sec=$(attr "$out" renderSeconds)
+      spp=$(attr "$out" spp)
+      rel=$("$bin" diff "$out" "$ref" | awk '{print $2}')
+      # Paths per spp: one per pixel, or one per chain for Metropolis.
+      perSpp=$(if [ "$mode" = mlt ]; then attr "$out" mltChains; else echo $((size * size)); fi)
+      prod=$(calc "$rel * $sec")
+      rate=$(calc "$spp * $perSpp / $sec / 1000000")
+      perPath=$(calc "$rel * $spp")
+      printf "%-14s %-5s seed %d: relMSE %.5g  %.2f s  %d spp  %.3f Mpaths/s  relMSE x s %.5g  relMSE x spp %.4g\n" \
+        "$name" "$mode" "$r" "$rel" "$sec" "$spp" "$rate" "$prod" "$perPath"
+      echo "$rel $sec $prod $rate $perPath" >> "$dir/$name.$mode"
+    done
+  done
+  for mode in path "$integrator"; do
+    rel=$(awk '{print $1}' "$dir/$name.$mode" | median)
+    sec=$(awk '{print $2}' "$dir/$name.$mode" | median)
+    prod=$(awk '{print $3}' "$dir/$name.$mode" | median)
+    rate=$(awk '{print $4}' "$dir/$name.$mode" | median)
+    perPath=$(awk '{print $5}' "$dir/$name.$mode" | median)
+    printf "%-14s %-5s median: relMSE %.5g  %.2f s  %.3f Mpaths/s  relMSE x s %.5g  relMSE x spp %.4g\n" "$name" "$mode" "$rel" \
+      "$sec" "$rate" "$prod" "$perPath"
+    echo "$prod" > "$dir/$name.$mode.median"
+  done
+  printf "%-14s path / %s (relMSE x s): %.3f\n" "$name" "$integrator" \
+    "$(calc "$(cat "$dir/$name.path.median") / $(cat "$dir/$name.$integrator.median")")"
+done
