@@ -96,20 +96,13 @@ VegasIntegrator::VegasIntegrator(vk::Context& ctx, StageGlobals& globals, const 
     spec[13] = k;  // constant 13: VEGAS_KERNEL
     m_kernels.push_back(vk::createComputePipeline(m_ctx, globals.layout(), "vegas", spec));
   }
-  VkCommandBufferAllocateInfo ai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-  ai.commandPool = m_ctx.commandPool;
-  ai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-  ai.commandBufferCount = 1;
-  VK_CHECK(vkAllocateCommandBuffers(m_ctx.device, &ai, &m_cmd));
-  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-  VK_CHECK(vkCreateFence(m_ctx.device, &fci, nullptr, &m_fence));
+  m_recorder = vk::createRecorder(m_ctx);
 }
 
 VegasIntegrator::~VegasIntegrator() {
   VkDevice d = m_ctx.device;
   vkDeviceWaitIdle(d);
-  if (m_fence) vkDestroyFence(d, m_fence, nullptr);
-  if (m_cmd) vkFreeCommandBuffers(d, m_ctx.commandPool, 1, &m_cmd);
+  vk::destroyRecorder(m_ctx, m_recorder);
   for (auto& p : m_kernels) vk::destroyComputePipeline(m_ctx, p);
   for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
 }
@@ -145,24 +138,15 @@ void VegasIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t sample
     g.passSamples = samples;
     m_globals.upload();
 
-    VK_CHECK(vkResetCommandBuffer(m_cmd, 0));
-    VkCommandBufferBeginInfo bi{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    VK_CHECK(vkBeginCommandBuffer(m_cmd, &bi));
+    VkCommandBuffer cmd = vk::beginRecording(m_ctx, m_recorder);
     const VkDescriptorSet set = m_globals.set();
-    vkCmdBindDescriptorSets(m_cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_globals.layout(), 0, 1, &set, 0, nullptr);
-    dispatch(m_cmd, VEGAS_KERNEL_WARP, count);
-    m_paths->recordTrace(m_cmd, count);
-    vk::computeBarrier(m_cmd);
-    dispatch(m_cmd, VEGAS_KERNEL_WEIGH, count);
-    m_paths->recordAccumulate(m_cmd, count);
-    VK_CHECK(vkEndCommandBuffer(m_cmd));
-    VkSubmitInfo si{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-    si.commandBufferCount = 1;
-    si.pCommandBuffers = &m_cmd;
-    VK_CHECK(vkResetFences(m_ctx.device, 1, &m_fence));
-    VK_CHECK(vkQueueSubmit(m_ctx.queue, 1, &si, m_fence));
-    VK_CHECK(vkWaitForFences(m_ctx.device, 1, &m_fence, VK_TRUE, UINT64_MAX));
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_globals.layout(), 0, 1, &set, 0, nullptr);
+    dispatch(cmd, VEGAS_KERNEL_WARP, count);
+    m_paths->recordTrace(cmd, count);
+    vk::computeBarrier(cmd);
+    dispatch(cmd, VEGAS_KERNEL_WEIGH, count);
+    m_paths->recordAccumulate(cmd, count);
+    vk::submitAndWait(m_ctx, m_recorder);
     m_paths->foldStats();
   }
   learn(paths);

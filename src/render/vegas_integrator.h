@@ -81,8 +81,7 @@ class VegasIntegrator : public Integrator {
   vk::Buffer* m_cdf = nullptr;    // host visible
   vk::Buffer* m_sums = nullptr;   // host visible
   std::vector<vk::ComputePipeline> m_kernels;  // by VEGAS_KERNEL_*
-  VkCommandBuffer m_cmd = VK_NULL_HANDLE;
-  VkFence m_fence = VK_NULL_HANDLE;
+  vk::Recorder m_recorder;
 };
 
 }  // namespace nusselt
