@@ -28,7 +28,7 @@ std::uint32_t MltIntegrator::iterationsPerPassFor(const RenderSettings& s) {
 
 MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
                              std::unique_ptr<PathIntegrator> paths, std::uint64_t pixels)
-    : m_ctx(ctx), m_globals(globals), m_settings(settings), m_paths(std::move(paths)), m_pixels(pixels) {
+    : PrimarySampleIntegrator(ctx, globals, settings, std::move(paths), pixels) {
   m_chains = m_paths->capacity();
   m_dims = globals.host().primaryDims;
   if (m_dims == 0 || m_chains == 0) throw Error("mlt: the path tracer has no primary samples");
@@ -36,11 +36,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m_report.chains = m_chains;
   m_report.dims = m_dims;
   m_report.bootstrapPaths = m_poolSize;
-  m_buffers.reserve(8);
-  auto make = [&](VkDeviceSize bytes, const std::string& what, bool host = false) -> vk::Buffer* {
-    m_buffers.push_back(vk::createBuffer(m_ctx, bytes, 0, host, what));
-    return &m_buffers.back();
-  };
+  auto make = [&](VkDeviceSize bytes, const std::string& what, bool host = false) { return makeBuffer(bytes, what, host); };
   m_mlt = make(sizeof(GpuMlt), "mlt state", true);
   vk::Buffer* current = make(std::uint64_t(shared::primarySampleSlots(m_chains)) * m_dims * 8, "mlt current vectors");
   vk::Buffer* state = make(std::uint64_t(m_chains) * 16, "mlt chain states");
@@ -66,45 +62,10 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   vkCmdFillBuffer(cmd, m_splats->buffer, 0, VK_WHOLE_SIZE, 0);
   vk::endOneShot(m_ctx, cmd);
 
-  for (std::uint32_t k = 0; k <= MLT_KERNEL_RESOLVE; ++k) {
-    std::vector<std::uint32_t> spec(14, 0u);
-    spec[13] = k;  // constant 13: MLT_KERNEL
-    m_kernels.push_back(vk::createComputePipeline(m_ctx, globals.layout(), "mlt", spec));
-  }
-  m_recorder = vk::createRecorder(m_ctx);
+  createKernels("mlt", MLT_KERNEL_RESOLVE + 1);
 }
 
-MltIntegrator::~MltIntegrator() {
-  VkDevice d = m_ctx.device;
-  vkDeviceWaitIdle(d);
-  vk::destroyRecorder(m_ctx, m_recorder);
-  for (auto& p : m_kernels) vk::destroyComputePipeline(m_ctx, p);
-  for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
-}
-
-std::uint64_t MltIntegrator::deviceBytes() const {
-  std::uint64_t total = m_paths->deviceBytes();
-  for (const vk::Buffer& b : m_buffers) total += b.size;
-  return total;
-}
-
-VkCommandBuffer MltIntegrator::begin() {
-  VkCommandBuffer cmd = vk::beginRecording(m_ctx, m_recorder);
-  const VkDescriptorSet set = m_globals.set();
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_globals.layout(), 0, 1, &set, 0, nullptr);
-  return cmd;
-}
-
-void MltIntegrator::submit() {
-  vk::submitAndWait(m_ctx, m_recorder);
-  m_paths->foldStats();
-}
-
-void MltIntegrator::dispatch(VkCommandBuffer cmd, std::uint32_t kernel, std::uint32_t n) {
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_kernels[kernel].pipeline);
-  vkCmdDispatch(cmd, (n + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE, 1, 1);
-  vk::computeBarrier(cmd);
-}
+MltIntegrator::~MltIntegrator() = default;
 
 void MltIntegrator::bootstrap() {
   auto t0 = std::chrono::steady_clock::now();

@@ -24,8 +24,7 @@
 #include <utility>
 #include <vector>
 
-#include "render/integrator.h"
-#include "render/path_integrator.h"
+#include "render/primary_sample_integrator.h"
 
 namespace nusselt {
 
@@ -38,7 +37,7 @@ struct MltReport {
   double acceptance() const { return proposals ? double(accepted) / double(proposals) : 0.0; }
 };
 
-class MltIntegrator : public Integrator {
+class MltIntegrator : public PrimarySampleIntegrator {
  public:
   // paths: the path tracer, created with PathOptions{primaryDimsFor(maxDepth), imageSamples,
   // capacity = settings.mltChains}.
@@ -56,44 +55,26 @@ class MltIntegrator : public Integrator {
   // `samples` iterations (one mutation of every chain each), iterations sampleIndex ..
   // sampleIndex + samples - 1; the bootstrap runs before the first.
   void renderPass(std::uint32_t sampleIndex, std::uint32_t samples) override;
-  RenderStats stats() const override { return m_paths->stats(); }
-  void addStats(const RenderStats& carried) override { m_paths->addStats(carried); }
-  const std::vector<std::pair<std::string, double>>& stageSeconds() const override { return m_paths->stageSeconds(); }
-  const std::vector<std::uint64_t>& raysPerBounce() const override { return m_paths->raysPerBounce(); }
-  std::uint64_t deviceBytes() const override;
-  PathIntegrator& paths() { return *m_paths; }
   const MltReport& report() const { return m_report; }
   // f (luminance of L) of every bootstrap path, in pool order (after the first pass; tests).
   const std::vector<float>& bootstrapValues() const { return m_poolValues; }
 
  private:
   void bootstrap();
-  // Records kernel k over n invocations (and a barrier).
-  void dispatch(VkCommandBuffer cmd, std::uint32_t kernel, std::uint32_t n);
-  VkCommandBuffer begin();
-  void submit();
   // One submission: kernel `before` over n chains, the path tracer's trace of their paths, then
   // kernel `after` (the pool, the chains' starts, every step).
   void traceBetween(std::uint32_t before, std::uint32_t after, std::uint32_t n);
   void readCounters();
 
-  vk::Context& m_ctx;
-  StageGlobals& m_globals;
-  RenderSettings m_settings;
-  std::unique_ptr<PathIntegrator> m_paths;
-  std::uint64_t m_pixels = 0;
   std::uint32_t m_chains = 0, m_dims = 0, m_poolSize = 0;
   bool m_bootstrapped = false;
   MltReport m_report;
   std::vector<float> m_poolValues;
-  std::vector<vk::Buffer> m_buffers;
   vk::Buffer* m_mlt = nullptr;  // the GpuMlt (host visible)
   vk::Buffer* m_poolF = nullptr;
   vk::Buffer* m_start = nullptr;
   vk::Buffer* m_counters = nullptr;
   vk::Buffer* m_splats = nullptr;
-  std::vector<vk::ComputePipeline> m_kernels;  // by MLT_KERNEL_*
-  vk::Recorder m_recorder;
 };
 
 }  // namespace nusselt

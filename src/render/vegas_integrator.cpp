@@ -61,7 +61,7 @@ std::uint64_t VegasIntegrator::bytesFor(const RenderSettings& s) {
 
 VegasIntegrator::VegasIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
                                  std::unique_ptr<PathIntegrator> paths, std::uint64_t pixels)
-    : m_ctx(ctx), m_globals(globals), m_settings(settings), m_paths(std::move(paths)), m_pixels(pixels) {
+    : PrimarySampleIntegrator(ctx, globals, settings, std::move(paths), pixels) {
   const std::uint32_t dims = globals.host().primaryDims;
   if (dims != shared::vegasPrimaryDims(settings.vegasBounces))
     throw Error("vegas: the path tracer's primary draws do not cover the warped bounces");
@@ -73,11 +73,7 @@ VegasIntegrator::VegasIntegrator(vk::Context& ctx, StageGlobals& globals, const 
   m_report.dims = dims;
   m_report.maxDensity.assign(m_axes, 1.0f);
   m_G.assign(m_axes, std::vector<double>(m_bins, 0.0));
-  m_buffers.reserve(4);
-  auto make = [&](VkDeviceSize bytes, const std::string& what) -> vk::Buffer* {
-    m_buffers.push_back(vk::createBuffer(m_ctx, bytes, 0, true, what));
-    return &m_buffers.back();
-  };
+  auto make = [&](VkDeviceSize bytes, const std::string& what) { return makeBuffer(bytes, what, true); };
   m_vegas = make(sizeof(GpuVegas), "vegas state");
   m_cdf = make(std::uint64_t(m_axes) * (m_bins + 1) * 4, "vegas tables");
   m_sums = make(std::uint64_t(m_axes) * m_bins * 8, "vegas bin sums");
@@ -91,37 +87,14 @@ VegasIntegrator::VegasIntegrator(vk::Context& ctx, StageGlobals& globals, const 
   v.sums = m_sums->address;
   globals.host().vegas = m_vegas->address;
 
-  for (std::uint32_t k = 0; k <= VEGAS_KERNEL_WEIGH; ++k) {
-    std::vector<std::uint32_t> spec(14, 0u);
-    spec[13] = k;  // constant 13: VEGAS_KERNEL
-    m_kernels.push_back(vk::createComputePipeline(m_ctx, globals.layout(), "vegas", spec));
-  }
-  m_recorder = vk::createRecorder(m_ctx);
+  createKernels("vegas", VEGAS_KERNEL_WEIGH + 1);
 }
 
-VegasIntegrator::~VegasIntegrator() {
-  VkDevice d = m_ctx.device;
-  vkDeviceWaitIdle(d);
-  vk::destroyRecorder(m_ctx, m_recorder);
-  for (auto& p : m_kernels) vk::destroyComputePipeline(m_ctx, p);
-  for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
-}
-
-std::uint64_t VegasIntegrator::deviceBytes() const {
-  std::uint64_t total = m_paths->deviceBytes();
-  for (const vk::Buffer& b : m_buffers) total += b.size;
-  return total;
-}
+VegasIntegrator::~VegasIntegrator() = default;
 
 std::vector<float> VegasIntegrator::cdf(std::uint32_t axis) const {
   const float* c = static_cast<const float*>(m_cdf->mapped) + std::size_t(axis) * (m_bins + 1);
   return std::vector<float>(c, c + m_bins + 1);
-}
-
-void VegasIntegrator::dispatch(VkCommandBuffer cmd, std::uint32_t kernel, std::uint32_t n) {
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_kernels[kernel].pipeline);
-  vkCmdDispatch(cmd, (n + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE, 1, 1);
-  vk::computeBarrier(cmd);
 }
 
 void VegasIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples) {
@@ -138,16 +111,13 @@ void VegasIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t sample
     g.passSamples = samples;
     m_globals.upload();
 
-    VkCommandBuffer cmd = vk::beginRecording(m_ctx, m_recorder);
-    const VkDescriptorSet set = m_globals.set();
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_globals.layout(), 0, 1, &set, 0, nullptr);
+    VkCommandBuffer cmd = begin();
     dispatch(cmd, VEGAS_KERNEL_WARP, count);
     m_paths->recordTrace(cmd, count);
     vk::computeBarrier(cmd);
     dispatch(cmd, VEGAS_KERNEL_WEIGH, count);
     m_paths->recordAccumulate(cmd, count);
-    vk::submitAndWait(m_ctx, m_recorder);
-    m_paths->foldStats();
+    submit();
   }
   learn(paths);
 }

@@ -21,8 +21,7 @@
 #include <utility>
 #include <vector>
 
-#include "render/integrator.h"
-#include "render/path_integrator.h"
+#include "render/primary_sample_integrator.h"
 
 namespace nusselt {
 
@@ -43,7 +42,7 @@ struct VegasReport {
   std::vector<float> maxDensity;
 };
 
-class VegasIntegrator : public Integrator {
+class VegasIntegrator : public PrimarySampleIntegrator {
  public:
   // paths: the path tracer, created with PathOptions{vegasPrimaryDims(settings.vegasBounces)}.
   VegasIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
@@ -54,34 +53,19 @@ class VegasIntegrator : public Integrator {
   static std::uint64_t bytesFor(const RenderSettings& settings);
 
   void renderPass(std::uint32_t sampleIndex, std::uint32_t samples) override;
-  RenderStats stats() const override { return m_paths->stats(); }
-  void addStats(const RenderStats& carried) override { m_paths->addStats(carried); }
-  const std::vector<std::pair<std::string, double>>& stageSeconds() const override { return m_paths->stageSeconds(); }
-  const std::vector<std::uint64_t>& raysPerBounce() const override { return m_paths->raysPerBounce(); }
-  std::uint64_t deviceBytes() const override;
-  PathIntegrator& paths() { return *m_paths; }
   const VegasReport& report() const { return m_report; }
   // The current CDF of axis a (bins + 1 floats; tests).
   std::vector<float> cdf(std::uint32_t axis) const;
 
  private:
-  void dispatch(VkCommandBuffer cmd, std::uint32_t kernel, std::uint32_t n);
   void learn(std::uint64_t paths);
 
-  vk::Context& m_ctx;
-  StageGlobals& m_globals;
-  RenderSettings m_settings;
-  std::unique_ptr<PathIntegrator> m_paths;
-  std::uint64_t m_pixels = 0;
   std::uint32_t m_axes = 0, m_bins = 0;
   VegasReport m_report;
   std::vector<std::vector<double>> m_G;  // per axis, per bin
-  std::vector<vk::Buffer> m_buffers;
   vk::Buffer* m_vegas = nullptr;  // the GpuVegas (host visible)
   vk::Buffer* m_cdf = nullptr;    // host visible
   vk::Buffer* m_sums = nullptr;   // host visible
-  std::vector<vk::ComputePipeline> m_kernels;  // by VEGAS_KERNEL_*
-  vk::Recorder m_recorder;
 };
 
 }  // namespace nusselt
