@@ -44,32 +44,16 @@ void expectMltMatchesPath(std::uint32_t chains, std::uint32_t iterations, int se
   RenderSettings ps = base(1000);
   ps.spp = 8192;
   test::Rendered ref = test::render(scene, ps);
-  std::vector<double> refMean, refVar;
-  test::blockMeans(ref.image, refMean, &refVar);
-  const std::size_t tests = refMean.size();
-  std::vector<double> sum(tests, 0.0), sumSq(tests, 0.0);
+  std::vector<Image> replicas;
   for (int k = 0; k < seeds; ++k) {
     RenderSettings ms = mltSettings(10 + k, chains, iterations);
     ms.mltBootstrap = 1u << 17;
     test::Rendered r = test::render(scene, ms);
     EXPECT_EQ(r.stats.nonFiniteSamples, 0u);
-    std::vector<double> m;
-    test::blockMeans(r.image, m, nullptr);
-    for (std::size_t b = 0; b < tests; ++b) sum[b] += m[b], sumSq[b] += m[b] * m[b];
+    replicas.push_back(std::move(r.image));
   }
-  const double alpha = 0.001 / double(tests), n = seeds;
-  for (std::size_t b = 0; b < tests; ++b) {
-    const double mean = sum[b] / n, s2 = std::max(0.0, (sumSq[b] - n * mean * mean) / (n - 1));
-    const double t = (mean - refMean[b]) / std::sqrt(s2 / n + refVar[b]);
-    const double p = 2 * test::studentTail(std::abs(t), n - 1);
-    if (b + 1 == tests)
-      std::printf("%u chains x %u mutations, %d seeds: image luminance mlt %.5f +- %.5f, path %.5f +- %.5f (t %.2f)\n",
-                  chains, iterations, seeds, mean, std::sqrt(s2 / n), refMean[b], std::sqrt(refVar[b]), t);
-    EXPECT_GT(p, alpha) << (b + 1 == tests ? std::string("image") : "block " + std::to_string(b)) << ": mlt "
-                        << mean << " +- " << std::sqrt(s2 / n) << " vs path " << refMean[b] << " +- "
-                        << std::sqrt(refVar[b]) << " (t " << t << ", " << chains << " chains x " << iterations
-                        << " mutations)";
-  }
+  test::expectReplicasMatchReference(ref.image, replicas, "mlt",
+                                     std::to_string(chains) + " chains x " + std::to_string(iterations) + " mutations");
 }
 
 }  // namespace

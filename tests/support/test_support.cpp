@@ -120,6 +120,36 @@ double studentTail(double t, double nu) {
   return sum * (b - a) / (3 * n);
 }
 
+double expectReplicasMatchReference(const Image& reference, const std::vector<Image>& replicas, const std::string& what,
+                                    const std::string& detail) {
+  std::vector<double> refMean, refVar;
+  blockMeans(reference, refMean, &refVar);
+  const std::size_t tests = refMean.size();
+  std::vector<double> sum(tests, 0.0), sumSq(tests, 0.0);
+  for (const Image& img : replicas) {
+    std::vector<double> m;
+    blockMeans(img, m, nullptr);
+    for (std::size_t b = 0; b < tests; ++b) sum[b] += m[b], sumSq[b] += m[b] * m[b];
+  }
+  const double alpha = 0.001 / double(tests), n = double(replicas.size());
+  double imageT = 0;
+  for (std::size_t b = 0; b < tests; ++b) {
+    const double mean = sum[b] / n, s2 = std::max(0.0, (sumSq[b] - n * mean * mean) / (n - 1));
+    const double t = (mean - refMean[b]) / std::sqrt(s2 / n + refVar[b]);
+    const double p = 2 * studentTail(std::abs(t), n - 1);
+    if (b + 1 == tests) {
+      imageT = t;
+      std::printf("%s, %zu seeds: image luminance %.5f +- %.5f, path %.5f +- %.5f (t %.2f)%s%s\n", what.c_str(),
+                  replicas.size(), mean, std::sqrt(s2 / n), refMean[b], std::sqrt(refVar[b]), t,
+                  detail.empty() ? "" : "; ", detail.c_str());
+    }
+    EXPECT_GT(p, alpha) << (b + 1 == tests ? std::string("image") : "block " + std::to_string(b)) << ": " << what
+                        << " " << mean << " +- " << std::sqrt(s2 / n) << " vs path " << refMean[b] << " +- "
+                        << std::sqrt(refVar[b]) << " (t " << t << ")";
+  }
+  return imageT;
+}
+
 BrdfParityKernel::BrdfParityKernel(std::vector<std::pair<glm::vec3, glm::vec3>> pairs, std::uint64_t measured)
     : m_pairs(std::move(pairs)), m_measured(measured) {
   vk::Context& ctx = context();

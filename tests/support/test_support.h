@@ -41,6 +41,13 @@ Rendered render(const Scene& scene, const RenderSettings& settings);
 void blockMeans(const Image& img, std::vector<double>& mean, std::vector<double>* var);
 // Upper tail P(T > t) of Student's t with nu degrees of freedom.
 double studentTail(double t, double nu);
+// Independent replicas (renders with different seeds) of an estimator whose per-pixel variance the
+// film cannot give (Metropolis, VEGAS: a render's samples are correlated) against a path-traced
+// reference: per 4 x 4 block and for the image (blockMeans), Student t with the replicas' sample
+// variance plus the reference's variance, two-sided at 0.001 / tests (Bonferroni); a failure
+// names the block, `what` and `detail`. Prints the image's line; returns the image's t.
+double expectReplicasMatchReference(const Image& reference, const std::vector<Image>& replicas,
+                                    const std::string& what, const std::string& detail = "");
 
 // Runs an embedded standalone compute kernel (one that declares its own push-constant block of at
 // most 128 bytes, typically buffer device addresses, and no descriptor sets) over `invocations`
