@@ -15,6 +15,8 @@
 #include <random>
 
 #include "brdf/registry.h"
+#include "quadtree/quadtree_build.h"
+#include "test_quadtree_chi2.h"
 
 namespace nusselt {
 namespace {
@@ -254,6 +256,113 @@ TEST(RoughDielectric, CatalogueAndDispatch) {
   EXPECT_EQ(shared::brdfEval(MODEL_ROUGH_DIELECTRIC, p, wi, wo).x, float(F(0.2f, 1.5f, wi, wo)));
   EXPECT_GT(F(0.2f, 1.5f, wi, wo), 0.0);
   EXPECT_EQ(F(0.2f, 1.5f, vec3(1, 0, 0), wo), 0.0);
+}
+
+// The generic sampler's two discs (quadtree_build.h, BuildSettings::lowerDisc): for the typical
+// and hard sets at 0, 30, 60 and 85 degrees, the upper tree's total is the reflected albedo R and
+// the lower tree's the transmitted one (radiance: T (n_o / n_i)^2), both against the Monte Carlo
+// estimate above (5 standard errors + 1e-4 relative: the builder's integration tolerance), and
+// every leaf's envelope bounds f on a 25 x 25 lattice (as Quadtree.EnvelopesBoundFOnADenseLattice).
+TEST(RoughDielectric, LowerDiscTreeTotalsAndEnvelopes) {
+  const ModelSpec* m = findModel("rough_dielectric");
+  unsigned seed = 900;
+  for (int hard = 0; hard < 2; ++hard) {
+    BrdfParams p = packParams(*m, hard ? hardParams(*m) : typicalParams(*m), "rough_dielectric");
+    float alpha = shared::brdfParam(p, ROUGH_DIELECTRIC_ALPHA), eta = shared::brdfParam(p, ROUGH_DIELECTRIC_ETA);
+    for (double th : {0.0, 30.0, 60.0, 85.0}) {
+      vec3 v = dirAt(th);
+      quadtree::BuildSettings bs;
+      quadtree::Tree up = quadtree::buildTree(m->id, p, v, bs);
+      bs.lowerDisc = true;
+      quadtree::Tree low = quadtree::buildTree(m->id, p, v, bs);
+      Split s = estimate(alpha, eta, v, kSamples, seed++);
+      // wo outside (n_o = 1), wi inside (n_i = eta): T (radiance) = the estimate / (n_i / n_o)^2.
+      double Trad = s.T / (eta * eta), seTrad = s.seT / (eta * eta);
+      std::printf("[rough_dielectric trees] %s theta=%2.0f  upper %.6f (MC R %.6f +-%.1e)  lower %.6f (MC T %.6f +-%.1e)  "
+                  "leaves %u + %u, depth %u / %u\n",
+                  hard ? "hard   " : "typical", th, up.mass, s.R, s.seR, low.mass, Trad, seTrad, up.stats.leaves,
+                  low.stats.leaves, up.stats.maxDepth, low.stats.maxDepth);
+      EXPECT_NEAR(up.mass, s.R, kZ * s.seR + 1e-4 * s.R) << "theta " << th << " hard " << hard;
+      EXPECT_NEAR(low.mass, Trad, kZ * seTrad + 1e-4 * Trad) << "theta " << th << " hard " << hard;
+      quadtree::EnvelopeAudit a = quadtree::auditEnvelopes(m->id, p, v, low, 24, true);
+      EXPECT_EQ(a.leavesAbove, 0u) << "lower disc theta " << th << " hard " << hard << ": worst f / e " << a.worst;
+      // The audit sees the lower disc's f (a tree audited as upper would be checked against the
+      // reflection, a different function).
+      EXPECT_GT(a.leaves, 0u);
+    }
+  }
+}
+
+// The generic sampler over both discs (quadtree.h, QT_SET_TRANSMITS), on the CPU: for the typical
+// and hard sets at 0, 30, 60, 85 degrees (tables) and 37.3 (between tables), 2^20 samples binned
+// over the sphere (qttest::quadChiSquare: 16 rings in cos theta over [-1, 1] with an edge at 0, x 32
+// sectors, equal-probability bins of an independent pilot run; expected counts from quadPdf), at
+// significance 0.01 with Bonferroni over the 10 cases; the share of samples below the surface
+// against the tables' a_low / (a_up + a_low) (on tables; z-test, |z| < 5); the pdf integrates to 1
+// over the sphere; on tables every weight f |cos| / pdf is a_up + a_low (2e-3); no bound
+// violations, no trial failures. (Quadtree.ChiSquareCpu runs these cases too, within its matrix.)
+// Then the same test must reject a broken sampler: the tables' lower masses halved, which halves
+// the probability of the lower disc while its trees (and so the density within it) stay as they
+// are; its pdf claims f |cos| / (a_up + a_low / 2) (a sampler that can fail).
+TEST(RoughDielectric, ChiSquareBothDiscs) {
+  const ModelSpec* m = findModel("rough_dielectric");
+  const std::uint32_t n = qttest::kSamples;
+  const std::vector<double> angles = {0.0, 30.0, 60.0, 85.0, 37.3};
+  const double alpha = 0.01 / (2.0 * double(angles.size()));
+  int brokenRejected = 0, brokenCases = 0;
+  for (int hard = 0; hard < 2; ++hard) {
+    BrdfParams p = packParams(*m, hard ? hardParams(*m) : typicalParams(*m), "rough_dielectric");
+    std::vector<std::uint32_t> idx;
+    quadtree::SamplerTables t = quadtree::buildSamplerTables({{m->id, p}}, qttest::testSettings(), idx);
+    ASSERT_EQ(t.sets.size(), 1u);
+    ASSERT_NE(t.sets[0].info.w & QT_SET_TRANSMITS, 0u);
+    ASSERT_EQ(t.tables.size(), 2u * t.sets[0].info.y * t.sets[0].info.z);
+    for (double th : angles) {
+      qttest::Case c{"rough_dielectric", hard != 0, th, 0.0};
+      vec3 v = qttest::knownDirection(c);
+      quadtree::SampleBatch b = quadtree::sampleCpu(t, 0, m->id, p, v, n, 1234u);
+      quadtree::SampleBatch pilot = quadtree::sampleCpu(t, 0, m->id, p, v, qttest::kPilotSamples, 99u);
+      EXPECT_EQ(b.boundViolations, 0u) << c.name();
+      EXPECT_EQ(b.trialFailures, 0u) << c.name();
+      qttest::Chi2Result r = qttest::quadChiSquare(t, 0, m->id, p, v, pilot.wPdf, b.wPdf);
+      bool onTable = std::fmod(th, 1.0) == 0.0;
+      std::uint32_t k = std::uint32_t(std::lround(th));
+      double aUp = t.tables[k].data.x, aLow = t.tables[t.sets[0].info.y + k].data.x;
+      double below = 0, ok = 0, lo = 1e30, hi = 0;
+      for (std::uint32_t i = 0; i < n; ++i) {
+        if (b.wPdf[i].w <= 0) continue;
+        ++ok;
+        if (b.wPdf[i].z < 0) ++below;
+        double wgt = shared::luminance(vec3(b.fOk[i])) * std::abs(b.wPdf[i].z) / b.wPdf[i].w / (aUp + aLow);
+        lo = std::min(lo, wgt);
+        hi = std::max(hi, wgt);
+      }
+      double share = aLow / (aUp + aLow), z = (below / ok - share) / std::sqrt(share * (1 - share) / ok);
+      std::printf("[rough_dielectric chi2] %-44s p=%.3g chi2=%.1f dof=%d sum(pdf)=%.5f below %.5f (a_low/a %.5f, z=%.2f) "
+                  "weight/a in [%.5f, %.5f] evals/sample=%.3f\n",
+                  c.name().c_str(), r.pValue, r.chi2, r.dof, r.expectedTotal, below / ok, share, z, lo, hi,
+                  double(b.evaluations) / n);
+      EXPECT_NEAR(r.expectedTotal, 1.0, 2e-4) << c.name();
+      EXPECT_GE(r.pValue, alpha) << c.name() << "\n" << r.dump;
+      if (onTable) {
+        EXPECT_LT(std::abs(z), 5.0) << c.name();
+        EXPECT_NEAR(lo, 1.0, 2e-3) << c.name();
+        EXPECT_NEAR(hi, 1.0, 2e-3) << c.name();
+      }
+      // The broken sampler (tables' lower masses halved), on tables, the typical set.
+      if (!onTable || hard) continue;
+      quadtree::SamplerTables broken = t;
+      for (std::uint32_t j = t.sets[0].info.y; j < broken.tables.size(); ++j) broken.tables[j].data.x *= 0.5f;
+      quadtree::SampleBatch bb = quadtree::sampleCpu(broken, 0, m->id, p, v, n, 1234u);
+      quadtree::SampleBatch bp = quadtree::sampleCpu(broken, 0, m->id, p, v, qttest::kPilotSamples, 99u);
+      qttest::Chi2Result rb = qttest::quadChiSquare(broken, 0, m->id, p, v, bp.wPdf, bb.wPdf);
+      std::printf("[rough_dielectric chi2] broken (lower disc probability halved) %s: p=%.3g chi2=%.1f dof=%d\n",
+                  c.name().c_str(), rb.pValue, rb.chi2, rb.dof);
+      ++brokenCases;
+      if (rb.pValue < alpha) ++brokenRejected;
+    }
+  }
+  EXPECT_EQ(brokenRejected, brokenCases) << "the chi-square test did not reject every broken sampler";
 }
 
 }  // namespace
