@@ -142,6 +142,11 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
   uint s = effectiveSampler(strategy, quadSet);
   vec3 f;
   if (!strategySample(s, model, quadSet, p, wo, u, wi, pdf, f)) return false;
+  // A transmitting model's quadtree sample below the surface (QT_SET_TRANSMITS): the path tracer
+  // does not continue inside yet (issue 18, phase 3), so the sample ends the path. The reflection
+  // stays unbiased (its samples keep weight f cos / pdf); the transmitted light is missing.
+  // (Never true for other models: their samples lie above the surface.)
+  if (wi.z < 0.0f) return false;
   weight = f * (wi.z / pdf);
 #if NUSSELT_WITH_QUADTREE
   // The random-walk source's roulette: continue with the tabulated directional albedo. With

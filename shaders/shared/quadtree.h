@@ -150,9 +150,13 @@ SHARED_FN float quadEvalLum(uint model, BrdfParams p, vec3 w, vec3 v) {
 
 // Solid-angle density of the mixture at the canonical direction wc (wc.z > 0): the (bi)linear
 // mixture of the neighbouring trees, plus eps cos / pi when the direction is between tables.
+// Transmitting sets (QT_SET_TRANSMITS): wc on either side, each tree pair's density
+// f |cos| / (a_up + a_low), and the defensive part eps |cos| / (2 pi) (a cosine on each side).
 SHARED_FN float quadMixturePdf(QuadSet S, uint model, BrdfParams p, uvec4 idx, vec2 ts, float eps, vec3 wc) {
-  if (wc.z <= 0.0f) return 0.0f;
+  bool transmits = (S.info.w & QT_SET_TRANSMITS) != 0u;
+  if (wc.z <= 0.0f && !(transmits && wc.z < 0.0f)) return 0.0f;
   uint np = S.info.z;
+  uint lower = S.info.x + S.info.y * np;  // first lower-disc table (transmitting sets)
   float sum = 0.0f;
   for (uint c = 0u; c < 4u; ++c) {
     float wt = ((c & 1u) != 0u ? ts.x : 1.0f - ts.x) * ((c & 2u) != 0u ? ts.y : 1.0f - ts.y);
@@ -160,18 +164,22 @@ SHARED_FN float quadMixturePdf(QuadSet S, uint model, BrdfParams p, uvec4 idx, v
     uint k = (c & 1u) != 0u ? idx.y : idx.x;
     uint j = (c & 2u) != 0u ? idx.w : idx.z;
     QuadTable T = QT_TABLE(S.info.x + k * np + j);
-    if (T.data.x <= 0.0f) continue;
-    sum += wt * quadEvalLum(model, p, wc, quadTableDirection(T)) / T.data.x;
+    float mass = T.data.x;
+    if (transmits) mass += QT_TABLE(lower + k * np + j).data.x;
+    if (mass <= 0.0f) continue;
+    sum += wt * quadEvalLum(model, p, wc, quadTableDirection(T)) / mass;
   }
+  if (transmits) return (1.0f - eps) * sum * abs(wc.z) + eps * abs(wc.z) * (0.5f * NUSSELT_INV_PI);
   return (1.0f - eps) * sum * wc.z + eps * wc.z * NUSSELT_INV_PI;
 }
 
 // ---- Public interface ---------------------------------------------------------------------------
 
 // Density per unit solid angle with which quadSample draws w for the known direction v (both in
-// the local frame, normal +z). 0 below the surface. For MIS; no tree descent.
+// the local frame, normal +z). 0 below the surface (transmitting sets: 0 in the plane of the
+// surface only). For MIS; no tree descent.
 SHARED_FN float quadPdf(uint set, uint model, BrdfParams p, vec3 v, vec3 w) {
-  if (v.z <= 0.0f || w.z <= 0.0f) return 0.0f;
+  if (v.z <= 0.0f || !(w.z > 0.0f || w.z < 0.0f)) return 0.0f;
   QuadSet S = QT_SET(set);
   vec4 fr = quadFrame((S.info.w & QT_SET_ANISOTROPIC) != 0u, v);
   uvec4 idx;
@@ -182,7 +190,8 @@ SHARED_FN float quadPdf(uint set, uint model, BrdfParams p, vec3 v, vec3 w) {
 
 // Tabulated directional albedo (luminance) at polar angle acos(cosTheta) and azimuth phi of the
 // known direction, interpolated (bi)linearly between tables: the Russian-roulette continuation
-// probability of the random-walk source.
+// probability of the random-walk source. Transmitting sets: both discs (R + T, the transmitted
+// part with its radiance scaling).
 SHARED_FN float quadAlbedo(uint set, float cosTheta, float phi) {
   QuadSet S = QT_SET(set);
   float c = clamp(cosTheta, 0.0f, 1.0f);
@@ -196,6 +205,13 @@ SHARED_FN float quadAlbedo(uint set, float cosTheta, float phi) {
   float a10 = QT_TABLE(S.info.x + idx.y * np + idx.z).data.x;
   float a01 = QT_TABLE(S.info.x + idx.x * np + idx.w).data.x;
   float a11 = QT_TABLE(S.info.x + idx.y * np + idx.w).data.x;
+  if ((S.info.w & QT_SET_TRANSMITS) != 0u) {
+    uint lower = S.info.x + S.info.y * np;
+    a00 += QT_TABLE(lower + idx.x * np + idx.z).data.x;
+    a10 += QT_TABLE(lower + idx.y * np + idx.z).data.x;
+    a01 += QT_TABLE(lower + idx.x * np + idx.w).data.x;
+    a11 += QT_TABLE(lower + idx.y * np + idx.w).data.x;
+  }
   return mix(mix(a00, a10, ts.x), mix(a01, a11, ts.x), ts.y);
 }
 
@@ -298,8 +314,9 @@ SHARED_FN bool quadDescend(uint root, bool aniso, float u, uvec4 stream, OUT(Qua
 // proposal (density proportional to the envelope e); points outside the leaf's region are
 // discarded before f is evaluated; the others are accepted with probability f / e. Trial t draws
 // from pcg4d(stream + (0, 0, 0, t)). False after QT_MAX_TRIALS rejected trials (counted as a trial
-// failure); samples that saw f > e are counted as bound violations.
-SHARED_FN bool quadLeafSample(uint model, BrdfParams p, vec3 vk, QuadDescent d, uvec4 stream, OUT(vec3) wc,
+// failure); samples that saw f > e are counted as bound violations. side = -1: a lower-disc tree
+// (QT_SET_TRANSMITS): f is evaluated at, and wc returned as, the point below the surface.
+SHARED_FN bool quadLeafSample(uint model, BrdfParams p, vec3 vk, QuadDescent d, uvec4 stream, float side, OUT(vec3) wc,
                               OUT(float) fl) {
   wc = vec3(0.0f);
   fl = 0.0f;
@@ -371,7 +388,7 @@ SHARED_FN bool quadLeafSample(uint model, BrdfParams p, vec3 vk, QuadDescent d, 
     if (co <= 0.0f) continue;
     float e = A * exp(k1 * (t1 - 0.5f) + k2 * (t2 - 0.5f));
     if (B > 0.0f) e += B * pow(co, -s);
-    wc = vec3(x, y, co);
+    wc = vec3(x, y, side * co);
     fl = quadEvalLum(model, p, wc, vk);
     ++evaluations;
     if (fl > e) {
@@ -393,7 +410,8 @@ SHARED_FN bool quadLeafSample(uint model, BrdfParams p, vec3 vk, QuadDescent d, 
 // ---- Sampling -------------------------------------------------------------------------------------
 
 // Draws w for the known direction v (local frame, v.z > 0) with density quadPdf (returned in
-// pdf, per unit solid angle) and returns f = brdfEval(model, p, w, v) (rgb). u: two uniform
+// pdf, per unit solid angle) and returns f = brdfEval(model, p, w, v) (rgb); w may lie below the
+// surface for a transmitting set (QT_SET_TRANSMITS). u: two uniform
 // numbers (component choice and tree descent); the descent's fresh numbers and the in-leaf
 // rejection draw from the stream of u (rngStreamKey(u.x, u.y, 0, RNG_REJECTION_STREAM), rng.h),
 // so the sample is a function of u alone. Returns false (w = 0, pdf = 0, f = 0) when v is below
@@ -415,9 +433,17 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, OU
   vec3 wc = vec3(0.0f);
 
   // ---- Component: defensive cosine (probability eps) or one of the neighbouring trees ----
+  bool transmits = (S.info.w & QT_SET_TRANSMITS) != 0u;
+  float massAll = 0.0f;  // a_up + a_low of the chosen table (transmitting sets)
   float uy = u.y;
   if (uy < eps) {
-    wc = squareToCosineHemisphere(vec2(u.x, min(uy / eps, NUSSELT_ONE_MINUS_EPS)));
+    if (transmits) {  // a cosine on either side, 1/2 each
+      bool below = u.x >= 0.5f;
+      wc = squareToCosineHemisphere(vec2(below ? 2.0f * u.x - 1.0f : 2.0f * u.x, min(uy / eps, NUSSELT_ONE_MINUS_EPS)));
+      if (below) wc.z = -wc.z;
+    } else {
+      wc = squareToCosineHemisphere(vec2(u.x, min(uy / eps, NUSSELT_ONE_MINUS_EPS)));
+    }
   } else {
     uy = (uy - eps) / (1.0f - eps);
     uint k = idx.x;
@@ -427,6 +453,18 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, OU
     if (uy >= 1.0f - ts.y) j = idx.w;
     QuadTable T = QT_TABLE(S.info.x + k * np + j);
     vec3 vk = quadTableDirection(T);
+    // Transmitting sets: the lower disc with probability a_low / (a_up + a_low), by what is left of uy.
+    float side = 1.0f;
+    massAll = T.data.x;
+    if (transmits) {
+      uy = uy >= 1.0f - ts.y ? (uy - (1.0f - ts.y)) / ts.y : uy / (1.0f - ts.y);
+      QuadTable L = QT_TABLE(S.info.x + S.info.y * np + k * np + j);
+      massAll = T.data.x + L.data.x;
+      if (L.data.x > 0.0f && uy * massAll >= T.data.x) {
+        T = L;
+        side = -1.0f;
+      }
+    }
     if (T.data.x <= 0.0f || T.info.x == QT_EMPTY) return false;
 
     // Further numbers: from `base`, the stream of u, hashed once more per draw. One hash of a key
@@ -438,12 +476,13 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, OU
     QuadDescent d;
     if (!quadDescend(T.info.x, aniso, u.x, uvec4(base.x, base.y, base.z ^ 0x5bd1e995u, base.w), d)) return false;
     float fl;
-    if (!quadLeafSample(model, p, vk, d, base, wc, fl)) return false;
+    if (!quadLeafSample(model, p, vk, d, base, side, wc, fl)) return false;
     if (eps == 0.0f && ts.x == 0.0f && ts.y == 0.0f) {
-      // On a table: one component, pdf = f(w, v_k) cos / a_k with the f already evaluated
-      // (at the mirror image for a mirrored sample: the same value, f being symmetric).
+      // On a table: one component, pdf = f(w, v_k) |cos| / a_k (transmitting: a_up + a_low) with
+      // the f already evaluated (at the mirror image for a mirrored sample: the same value, f
+      // being symmetric).
       w = quadFromCanonical(fr, wc);
-      pdf = fl * wc.z / T.data.x;
+      pdf = fl * abs(wc.z) / massAll;
       f = brdfEval(model, p, w, v);
       return pdf > 0.0f;
     }

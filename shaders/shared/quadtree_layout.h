@@ -79,6 +79,12 @@ STATIC_ASSERT_SIZE(QuadTable, 32);
 // Set flags: anisotropic sets tabulate phi in [0, 90 deg] and use the mirror symmetries x -> -x,
 // y -> -y (applied to both directions); isotropic sets rotate the known direction to phi = 0.
 #define QT_SET_ANISOTROPIC 1u
+// Transmitting models (<NAME>_TRANSMITS, ModelSpec::transmits): every table has a second tree over
+// the LOWER disc (the projection of the lower hemisphere, |cos theta| its Jacobian), stored as a
+// second block of tables right after the first: lower(k, j) = first + thetaTables * phiTables +
+// k * phiTables + j, with the same known direction. The sampler picks the lower disc with
+// probability a_low / (a_up + a_low) and its pdf is f |cos| / (a_up + a_low) on either side.
+#define QT_SET_TRANSMITS 2u
 // Trial cap of the in-leaf rejection loop (lavapipe truncates loops silently: every loop is
 // bounded). A trial is one proposal draw: discarded outside (leaf & disc) with probability about
 // 1/2 at most, then accepted with probability >= 1/n_max = 1/2 in uncapped leaves, so a failure

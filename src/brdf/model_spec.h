@@ -79,6 +79,7 @@ struct DiscRidge {
 };
 struct ModelFeatures {
   std::vector<std::array<double, 2>> peaks;
+  std::vector<std::array<double, 2>> lowerPeaks;  // transmitting models: peaks on the lower disc (refraction direction)
   std::vector<DiscRidge> ridges;
 };
 
@@ -86,6 +87,7 @@ struct ModelSpec {
   std::string name;
   std::uint32_t id = 0;  // MODEL_<NAME> in shaders/shared/brdf/models.h
   bool delta = false;    // mirror, dielectric: never evaluated or light-sampled (<NAME>_DELTA)
+  bool transmits = false; // f is not zero below the surface (<NAME>_TRANSMITS in the header: rough_dielectric)
   bool measured = false; // merl: a table read from a file (loadMerl, src/brdf/merl.h), no parameters
   std::vector<ParamSpec> params;
   std::string summary;

@@ -492,8 +492,9 @@ class Builder {
   std::vector<RulePoint> m_rx, m_ry;
   double m_aEst = 0;
 
-  // luminance(f(w, v)) (merl: merlEvalLum).
+  // luminance(f(w, v)) (merl: merlEvalLum); on the lower disc at the mirror image below the surface.
   double evalLum(vec3 w) const {
+    if (m_s.lowerDisc) return quadEvalLum(m_model, m_params, vec3(w.x, w.y, -w.z), m_v);
     return m_merl ? merlEvalLum(*m_merl, w, m_v) : quadEvalLum(m_model, m_params, w, m_v);
   }
   double eval(double x, double y, double c, double phi, double w, CellResult& r) {
@@ -559,7 +560,10 @@ void Builder::collectPeaks() {
   // replace the default ones below.
   ModelFeatures features;
   if (const auto hook = modelById(m_model).features) hook(m_params, m_v, features);
-  m_peaks.insert(m_peaks.end(), features.peaks.begin(), features.peaks.end());
+  // (Lower disc: the normal, the straight-through direction -v (= the mirror point above) and the
+  // rim points serve as they are; the model adds its refraction direction.)
+  const auto& extra = m_s.lowerDisc ? features.lowerPeaks : features.peaks;
+  m_peaks.insert(m_peaks.end(), extra.begin(), extra.end());
   for (const DiscRidge& r : features.ridges) m_ridges.push_back({r.axis, r.value});
   if (features.ridges.empty() && m_traits.anisotropic) {
     m_ridges.push_back({0, -vx});
@@ -1368,12 +1372,13 @@ void forEachLeaf(const QuadNode* nodes, const QuadLeaf* leaves, std::uint32_t ro
   }
 }
 
-EnvelopeAudit auditEnvelopes(std::uint32_t model, const BrdfParams& params, vec3 v, const Tree& tree, int grid) {
-  return auditEnvelopes(model, params, v, tree.nodes.data(), tree.leaves.data(), tree.root, tree.mass, grid);
+EnvelopeAudit auditEnvelopes(std::uint32_t model, const BrdfParams& params, vec3 v, const Tree& tree, int grid, bool lowerDisc) {
+  return auditEnvelopes(model, params, v, tree.nodes.data(), tree.leaves.data(), tree.root, tree.mass, grid, lowerDisc);
 }
 
 EnvelopeAudit auditEnvelopes(std::uint32_t model, const BrdfParams& params, vec3 v, const QuadNode* nodes, const QuadLeaf* leaves,
-                             std::uint32_t root, double mass, int grid) {
+                             std::uint32_t root, double mass, int grid, bool lowerDisc) {
+  const float side = lowerDisc ? -1.0f : 1.0f;
   EnvelopeAudit a;
   if (root == QT_EMPTY) return a;
   const bool aniso = modelTraits(model, params).anisotropic;
@@ -1392,7 +1397,7 @@ EnvelopeAudit auditEnvelopes(std::uint32_t model, const BrdfParams& params, vec3
                                        square ? y0 + size : L.box.w, x0, x0 + size, y0, y0 + size, t1, t2, x, y, c))
                       continue;
                     double e = envelopeAt(A, k1, k2, B, s, t1, t2, c);
-                    double f = quadEvalLum(model, params, vec3(float(x), float(y), float(c)), v);
+                    double f = quadEvalLum(model, params, vec3(float(x), float(y), side * float(c)), v);
                     ++a.evaluations;
                     if (f > 0) worst = std::max(worst, e > 0 ? f / e : INFINITY);
                   }

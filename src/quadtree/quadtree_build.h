@@ -19,6 +19,11 @@ struct BuildSettings {
                                // (1e-5 let two rules agree on a streak both missed: ashikhmin hard, 2e-4)
   double absTol = 2e-7;
   double tailTol = 1e-7;        // cells with mass <= tailTol a become leaves whatever their acceptance
+  // The lower disc of a transmitting model (ModelSpec::transmits): the tree is built over the
+  // projection of the LOWER hemisphere, a disc point (x, y) standing for w = (x, y, -sqrt(1 - r^2)),
+  // with density luminance(f(w, v)) (|cos| is the disc's Jacobian as above). Not part of the cache
+  // key: a material's lower trees are stored beside its upper ones (sampler_tables.cpp).
+  bool lowerDisc = false;
 };
 
 // What the model needs from the builder (rim exponent, anisotropy): declared by each model in
@@ -69,9 +74,12 @@ struct EnvelopeAudit {
   double massAbove = 0;
   std::uint64_t evaluations = 0;
 };
-EnvelopeAudit auditEnvelopes(std::uint32_t model, const shared::BrdfParams& params, shared::vec3 v, const Tree& tree, int grid);
+// lowerDisc: the tree is a lower-disc tree (BuildSettings::lowerDisc).
+EnvelopeAudit auditEnvelopes(std::uint32_t model, const shared::BrdfParams& params, shared::vec3 v, const Tree& tree, int grid,
+                             bool lowerDisc = false);
 // The same on flattened arrays (one table of a SamplerTables: its root and total mass).
 EnvelopeAudit auditEnvelopes(std::uint32_t model, const shared::BrdfParams& params, shared::vec3 v, const shared::QuadNode* nodes,
-                             const shared::QuadLeaf* leaves, std::uint32_t root, double mass, int grid);
+                             const shared::QuadLeaf* leaves, std::uint32_t root, double mass, int grid,
+                             bool lowerDisc = false);
 
 }  // namespace nusselt::quadtree

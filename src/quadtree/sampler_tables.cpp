@@ -15,6 +15,7 @@
 #include <map>
 #include <thread>
 
+#include "brdf/registry.h"
 #include "quadtree/quadtree_build.h"
 
 namespace nusselt::quadtree {
@@ -156,6 +157,7 @@ struct Unique {
   BrdfParams params;
   ModelTraits traits;
   std::uint32_t nTheta, nPhi;
+  bool transmits = false;  // the model transmits: a lower-disc tree per table too
   std::uint64_t key;
   MaterialTrees trees;
   bool fromCache = false;
@@ -218,6 +220,7 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
       u.traits = modelTraits(model, u.params);
       u.nTheta = std::max(1u, settings.thetaTables);
       u.nPhi = u.traits.anisotropic ? std::max(2u, settings.phiTables) : 1u;
+      u.transmits = modelById(model).transmits;
       struct KeyData {
         std::uint32_t version, model, nTheta, nPhi, maxDepth;
         float nMax, margin;
@@ -238,7 +241,7 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
   for (Unique& u : uniques) {
     if (!settings.useCache || !settings.onlyThetaTables.empty()) continue;
     int r = loadCache(u.key, u.trees);
-    if (r == 0 && u.trees.tables.size() == std::size_t(u.nTheta) * u.nPhi) {
+    if (r == 0 && u.trees.tables.size() == std::size_t(u.nTheta) * u.nPhi * (u.transmits ? 2 : 1)) {
       u.fromCache = true;
       out.cacheHits++;
     } else {
@@ -256,16 +259,17 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
   for (std::uint32_t ui = 0; ui < uniques.size(); ++ui) {
     Unique& u = uniques[ui];
     if (u.fromCache) continue;
-    std::uint32_t n = u.nTheta * u.nPhi;
+    // A transmitting model's tables: the upper discs [0, nTheta nPhi), then the lower discs of the
+    // same known directions (quadtree_layout.h, QT_SET_TRANSMITS).
+    std::uint32_t n1 = u.nTheta * u.nPhi, n = n1 * (u.transmits ? 2 : 1);
     u.built.resize(n);
     u.seconds.assign(n, 0.0);
     u.trees.tables.resize(n);
-    for (std::uint32_t k = 0; k < u.nTheta; ++k)
-      for (std::uint32_t j = 0; j < u.nPhi; ++j) u.trees.tables[k * u.nPhi + j] = makeTable(k, j, u.nTheta, u.nPhi);
+    for (std::uint32_t t = 0; t < n; ++t) u.trees.tables[t] = makeTable((t % n1) / u.nPhi, t % u.nPhi, u.nTheta, u.nPhi);
     // Most expensive first (grazing tables are the deepest): better balance.
     for (std::uint32_t t = n; t-- > 0;) {
       const auto& only = settings.onlyThetaTables;
-      if (!only.empty() && std::find(only.begin(), only.end(), t / u.nPhi) == only.end()) continue;
+      if (!only.empty() && std::find(only.begin(), only.end(), (t % n1) / u.nPhi) == only.end()) continue;
       jobs.push_back({ui, t});
     }
   }
@@ -277,7 +281,9 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
       Unique& u = uniques[jobs[i].u];
       auto t0 = std::chrono::steady_clock::now();
       vec3 v = quadTableDirection(u.trees.tables[jobs[i].t]);
-      u.built[jobs[i].t] = buildTree(u.model, u.params, v, bs);
+      BuildSettings tbs = bs;
+      tbs.lowerDisc = jobs[i].t >= u.nTheta * u.nPhi;
+      u.built[jobs[i].t] = buildTree(u.model, u.params, v, tbs);
       u.seconds[jobs[i].t] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
   };
@@ -342,7 +348,8 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
       return l + nodeBase;
     };
     QuadSet s;
-    s.info = uvec4(tableBase, u.nTheta, u.nPhi, u.traits.anisotropic ? QT_SET_ANISOTROPIC : 0u);
+    s.info = uvec4(tableBase, u.nTheta, u.nPhi,
+                   (u.traits.anisotropic ? QT_SET_ANISOTROPIC : 0u) | (u.transmits ? QT_SET_TRANSMITS : 0u));
     s.data = vec4(settings.defensive, float((M_PI / 2) / u.nTheta), u.nPhi > 1 ? float((M_PI / 2) / (u.nPhi - 1)) : 0.0f, 0.0f);
     out.sets.push_back(s);
     for (QuadTable t : u.trees.tables) {

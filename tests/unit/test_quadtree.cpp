@@ -200,7 +200,7 @@ TEST(Quadtree, ChiSquareCpu) {
     double lo = 1e30, hi = 0;
     for (std::uint32_t i = 0; i < n; ++i) {
       if (b.fOk[i].w <= 0) continue;
-      double wgt = luminance(vec3(b.fOk[i])) * b.wPdf[i].z / b.wPdf[i].w / albedo;
+      double wgt = luminance(vec3(b.fOk[i])) * std::abs(b.wPdf[i].z) / b.wPdf[i].w / albedo;  // (|cos|: transmitting sets)
       lo = std::min(lo, wgt);
       hi = std::max(hi, wgt);
     }

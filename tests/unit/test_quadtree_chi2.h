@@ -105,7 +105,8 @@ inline double gammaQ(double a, double x) {
 }
 
 // Rings [c[i], c[i+1]] (ascending, c[0] = 0, c.back() = 1) times sectors [phi[i][j], phi[i][j+1]]
-// covering [phi[i][0], phi[i][0] + 2 pi).
+// covering [phi[i][0], phi[i][0] + 2 pi). A sphere binning (transmitting models: samples on both
+// sides) has c[0] = -1 and an edge at c = 0.
 struct Binning {
   std::vector<double> c;
   std::vector<std::vector<double>> phi;
@@ -114,9 +115,9 @@ struct Binning {
     for (const auto& p : phi) n += p.size() - 1;
     return n;
   }
-  // Bin of direction w (upper hemisphere), rings first.
+  // Bin of direction w (upper hemisphere; the sphere for a sphere binning), rings first.
   std::size_t bin(vec3 w) const {
-    double cz = std::clamp(double(w.z), 0.0, 1.0);
+    double cz = std::clamp(double(w.z), c.front(), 1.0);
     std::size_t i = std::min<std::size_t>(c.size() - 2, std::size_t(std::upper_bound(c.begin(), c.end(), cz) - c.begin()) - 1);
     const std::vector<double>& e = phi[i];
     double ph = std::atan2(double(w.y), double(w.x));
@@ -143,21 +144,52 @@ inline Binning uniformBinning(int rings, int sectors) {
   return b;
 }
 
-// Equal-probability bins of an independent pilot sample (pdf 0 = failed, ignored).
-inline Binning quantileBinning(const std::vector<vec4>& pilot, int rings, int sectors) {
+// Equal-probability bins of an independent pilot sample (pdf 0 = failed, ignored). sphere: rings
+// over c in [-1, 1] (transmitting models), the quantile edge nearest to c = 0 moved there, so that
+// no bin straddles the surface.
+inline Binning quantileBinning(const std::vector<vec4>& pilot, int rings, int sectors, bool sphere = false) {
+  const double lo = sphere ? -1.0 : 0.0;
   std::vector<std::pair<double, double>> pts;  // (c, phi)
   for (const vec4& s : pilot)
-    if (s.w > 0) pts.push_back({std::clamp(double(s.z), 0.0, 1.0), std::atan2(double(s.y), double(s.x))});
-  if (pts.size() < std::size_t(rings * sectors * 4)) return uniformBinning(rings, sectors);
+    if (s.w > 0) pts.push_back({std::clamp(double(s.z), lo, 1.0), std::atan2(double(s.y), double(s.x))});
+  if (pts.size() < std::size_t(rings * sectors * 4)) {
+    Binning u = uniformBinning(rings, sectors);
+    if (sphere) {  // the same rings mirrored below
+      Binning b;
+      for (std::size_t i = u.c.size(); i-- > 1;) b.c.push_back(-u.c[i]);
+      b.c.insert(b.c.end(), u.c.begin(), u.c.end());
+      b.phi = u.phi;
+      b.phi.insert(b.phi.end(), u.phi.begin(), u.phi.end());
+      return b;
+    }
+    return u;
+  }
   std::sort(pts.begin(), pts.end());
   Binning b;
-  b.c.push_back(0);
+  b.c.push_back(lo);
   std::size_t n = pts.size();
   for (int i = 1; i < rings; ++i) b.c.push_back(pts[i * n / rings].first);
   b.c.push_back(1);
+  if (sphere) {
+    std::size_t k = 1;
+    for (std::size_t i = 1; i + 1 < b.c.size(); ++i)
+      if (std::abs(b.c[i]) < std::abs(b.c[k])) k = i;
+    b.c[k] = 0;
+  }
   for (int i = 0; i < rings; ++i) {
     std::vector<double> ph;
-    for (std::size_t k = i * n / rings; k < (i + 1) * n / rings; ++k) ph.push_back(pts[k].second);
+    if (!sphere) {
+      for (std::size_t k = i * n / rings; k < (i + 1) * n / rings; ++k) ph.push_back(pts[k].second);
+    } else {
+      for (std::size_t k = 0; k < n; ++k)  // the points of ring [c[i], c[i+1]) (the edge at 0 moved)
+        if (pts[k].first >= b.c[i] && (pts[k].first < b.c[i + 1] || i + 1 == std::size_t(rings))) ph.push_back(pts[k].second);
+    }
+    if (ph.size() < std::size_t(sectors)) {  // (sphere: a ring the moved edge emptied) equal sectors
+      std::vector<double> e;
+      for (int j = 0; j <= sectors; ++j) e.push_back(-M_PI + 2 * M_PI * j / sectors);
+      b.phi.push_back(e);
+      continue;
+    }
     std::sort(ph.begin(), ph.end());
     std::vector<double> e{-M_PI};
     for (int j = 1; j < sectors; ++j) e.push_back(ph[j * ph.size() / sectors]);
@@ -168,6 +200,7 @@ inline Binning quantileBinning(const std::vector<vec4>& pilot, int rings, int se
   }
   // Strictly ascending rings too.
   for (std::size_t i = 1; i < b.c.size(); ++i) b.c[i] = std::max(b.c[i], std::nextafter(b.c[i - 1], 10.0));
+  if (sphere) b.c.front() = -1.0;
   b.c.back() = std::max(1.0, b.c.back());
   return b;
 }
@@ -197,7 +230,7 @@ inline double binRule(const PdfFn& pdf, double a0, double a1, double b0, double 
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) {
       double c = a0 + (a1 - a0) * 0.5 * (1 + gx[i]), ph = b0 + (b1 - b0) * 0.5 * (1 + gx[j]);
-      if (c <= 0) continue;
+      if (c == 0) continue;  // (the Gauss points never reach c = 0: interior nodes of rings that end there)
       double f = pdf(binDirection(c, ph));
       if (fmax) *fmax = std::max(*fmax, f);
       s += gw[i] * gw[j] * f;
@@ -243,7 +276,7 @@ inline double binIntegral(const PdfFn& pdf, double c0, double c1, double p0, dou
       double bmax = 0;
       for (double c : {c0, cm, c1})
         for (double ph : {p0, pm, p1})
-          if (c > 0 && (c != cm || ph != pm)) bmax = std::max(bmax, pdf(binDirection(c, ph)));
+          if (c != 0 && (c != cm || ph != pm)) bmax = std::max(bmax, pdf(binDirection(c, ph)));
       if (bmax <= 4 * qmax || bmax * (c1 - c0) * (p1 - p0) < 1e-12) return parts;
     }
     sc = sp = true;
@@ -351,9 +384,10 @@ inline Chi2Result chiSquare(const Binning& bins, const std::vector<double>& prob
 }
 
 // The quadtree sampler's test for one case: pilot bins from `pilot`, expected counts from quadPdf.
+// Transmitting models: bins over the sphere (both discs, each with its share of the samples).
 inline Chi2Result quadChiSquare(const quadtree::SamplerTables& t, std::uint32_t set, std::uint32_t model, const BrdfParams& p,
                                 vec3 v, const std::vector<vec4>& pilot, const std::vector<vec4>& samples) {
-  Binning bins = quantileBinning(pilot, 16, 32);
+  Binning bins = quantileBinning(pilot, 16, 32, modelById(model).transmits);
   std::vector<double> prob = binProbabilities([&](vec3 w) { return double(quadPdf(set, model, p, v, w)); }, bins, pilot,
                                               [&]() { return std::make_shared<quadtree::QuadHostScope>(t); });
   return chiSquare(bins, prob, samples);

@@ -33,6 +33,7 @@
 #include "gltf_pbr.h"
 #include "merl.h"
 #include "thin_dielectric.h"
+#include "rough_dielectric.h"
 
 // X(id, NAME, fn): MODEL_<NAME> = id; <NAME>_DELTA, <NAME>_ANALYTIC and the functions <fn>Eval,
 // <fn>Spec, ... come from the model's header.
@@ -58,7 +59,8 @@
   X(18u, DIELECTRIC, dielectric)           \
   X(19u, GLTF_PBR, gltfPbr)                \
   X(20u, MERL, merl)                       \
-  X(21u, THIN_DIELECTRIC, thinDielectric)
+  X(21u, THIN_DIELECTRIC, thinDielectric)   \
+  X(22u, ROUGH_DIELECTRIC, roughDielectric)
 
 // The models the dispatch switches below and in analytic_sampling.h contain: all of them, or
 // only one in a shade module built for a single model (CMakeLists.txt: -DNUSSELT_SHADE_MODEL_ID,
