@@ -69,6 +69,16 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     if (m.components.size() > MAX_COMPONENTS)
       throw Error("material " + m.name + ": " + std::to_string(m.components.size()) + " components, at most " +
                   std::to_string(MAX_COMPONENTS));
+    // A transmitting non-delta model (rough_dielectric) has its BSDF and its generic sampler over
+    // both hemispheres (nusselt sample, albedo, bench), but the shade stage does not continue a
+    // path below the surface yet: rendering it would silently drop its transmission.
+    for (std::size_t k = 0; k < std::max<std::size_t>(m.components.size(), 1); ++k) {
+      const std::uint32_t model = m.combined() ? m.components[k].model : m.model;
+      if (modelById(model).transmits && !modelById(model).delta)
+        throw Error("material " + m.name + ": model " + modelById(model).name +
+                    " transmits through a rough surface, which the path tracer does not render yet (its sampler "
+                    "and albedo are available in nusselt sample and nusselt albedo; docs/models.md)");
+    }
     std::vector<std::uint32_t> key = slotKey(m);
     if (std::find(m_slotKeys.begin(), m_slotKeys.end(), key) == m_slotKeys.end()) m_slotKeys.push_back(key);
   }

@@ -14,6 +14,7 @@
 #include "../support/test_support.h"
 #include "brdf/albedo.h"
 #include "brdf/registry.h"
+#include "util/error.h"
 
 using namespace nusselt;
 
@@ -226,6 +227,32 @@ TEST(CombinedFurnace, UniformSelectionMatchesAlbedoSelection) {
       std::printf("[ furnace  ] %s roulette, channel %d: albedo %.5f +- %.5f, uniform %.5f +- %.5f, z = %.2f\n",
                   rouletteModeName(roulette), c, albedo.mean[c], albedo.se[c], uniform.mean[c], uniform.se[c], z);
       EXPECT_LT(std::fabs(z), zMax) << rouletteModeName(roulette) << " roulette, channel " << c;
+    }
+  }
+}
+
+// A rough transmitting model has its BSDF and sampler, but the shade stage does not continue paths
+// below the surface yet: a render that uses it, alone or as a component, is refused with a message
+// naming the material and the model (not rendered as its reflection alone).
+TEST(Combined, RoughTransmissionIsRefusedNotRenderedAsReflection) {
+  RenderSettings s;
+  s.width = s.height = 8;
+  s.spp = 1;
+  for (bool combined : {false, true}) {
+    Scene scene = test::loadTestScene("scenes/tests/furnace.gltf");
+    ASSERT_EQ(scene.materials.size(), 1u);
+    if (combined)
+      setComponents(scene.materials[0], {catalogueComponent("lambert", {}, 0.5f),
+                                         catalogueComponent("rough_dielectric", {}, 0.5f)});
+    else
+      scene.materials[0] = catalogueMaterial("rough_dielectric", {}, scene.materials[0].name);
+    try {
+      Renderer r(test::context(), scene, s);
+      ADD_FAILURE() << "a scene with rough_dielectric was accepted (combined " << combined << ")";
+    } catch (const Error& e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find("model rough_dielectric transmits"), std::string::npos) << m;
+      EXPECT_NE(m.find("material " + scene.materials[0].name), std::string::npos) << m;
     }
   }
 }
