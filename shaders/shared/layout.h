@@ -261,6 +261,9 @@ struct GpuMlt {
   uvec4 info;
   uvec4 pool;
   vec4 params;
+  // Kelemen's weights: (1 when on, 1 / b' (b' from paths independent of the chains' starts),
+  // 1 / b, large-step probability); x = 0: plain expected-value splats.
+  vec4 weights;
   BUFREF(Vec2s) current;
   BUFREF(Vec4s) state;
   BUFREF(Uints) splats;
@@ -268,7 +271,7 @@ struct GpuMlt {
   BUFREF(Uints) start;
   BUFREF(Uints) counters;
 };
-STATIC_ASSERT_SIZE(GpuMlt, 96);
+STATIC_ASSERT_SIZE(GpuMlt, 112);
 #ifndef __cplusplus
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Mlts { GpuMlt v[]; };
 #endif

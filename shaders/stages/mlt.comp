@@ -80,9 +80,19 @@ void main() {
       float fp = luminance(Lp);
       uint pp = g.pathInfo.v[c].x;
       float a = fc > 0.0f ? min(1.0f, fp / fc) : 1.0f;
-      // Expected values: the proposal weighted by its acceptance, the current state by the rest.
-      if (fp > 0.0f && a > 0.0f) splat(m, pp, Lp * (a / fp));
-      if (fc > 0.0f && a < 1.0f) splat(m, floatBitsToUint(state.w), Lc * ((1.0f - a) / fc));
+      if (m.weights.x != 0.0f) {
+        // Kelemen et al.: the chain's expected values a and 1 - a, and a large step's path once more
+        // as an independent sample (1 / b: the resolve multiplies by b), each over f / b' + p.
+        float ib = m.weights.y;
+        float p = m.weights.w;
+        float wp = (a * ib + (large ? m.weights.z : 0.0f)) / (fp * ib + p);
+        if (fp > 0.0f && wp > 0.0f) splat(m, pp, Lp * wp);
+        if (fc > 0.0f && a < 1.0f) splat(m, floatBitsToUint(state.w), Lc * ((1.0f - a) * ib / (fc * ib + p)));
+      } else {
+        // Expected values: the proposal weighted by its acceptance, the current state by the rest.
+        if (fp > 0.0f && a > 0.0f) splat(m, pp, Lp * (a / fp));
+        if (fc > 0.0f && a < 1.0f) splat(m, floatBitsToUint(state.w), Lc * ((1.0f - a) / fc));
+      }
       accepted = mltUnit(h.y) < a;
       if (accepted) {
         for (uint d = 0u; d < dims; ++d) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];

@@ -59,6 +59,7 @@ struct RenderArgs {
   std::uint32_t mltBootstrap = 0;
   float mltLargeStep = 0.3f;
   float mltSigma = 0.01f;
+  std::string mltWeights = "kelemen";
   std::uint32_t vegasBins = 64;
   std::uint32_t vegasBounces = 1;
   float vegasAlpha = 0.2f;
@@ -108,6 +109,7 @@ int renderCommand(const RenderArgs& a) {
   s.mltBootstrap = a.mltBootstrap;
   s.mltLargeStep = a.mltLargeStep;
   s.mltSigma = a.mltSigma;
+  s.mltKelemen = a.mltWeights == "kelemen";
   s.vegasBins = a.vegasBins;
   s.vegasBounces = a.vegasBounces;
   s.vegasAlpha = a.vegasAlpha;
@@ -266,9 +268,10 @@ int renderCommand(const RenderArgs& a) {
     if (const MltIntegrator* mlt = renderer.mlt(); mlt && !a.quiet) {
       const MltReport& m = mlt->report();
       std::fprintf(stderr, "mlt: %u chains of %u primary draws; bootstrap %u paths (%llu with f > 0), b = %.6g, in %.2f s; "
-                           "%llu mutations, acceptance %.1f %% (large steps %.1f %% of them, accepted %.1f %%)\n",
+                           "%s; %llu mutations, acceptance %.1f %% (large steps %.1f %% of them, accepted %.1f %%)\n",
                    m.chains, m.dims, m.bootstrapPaths, static_cast<unsigned long long>(m.nonzeroBootstrap), m.b,
-                   m.bootstrapSeconds, static_cast<unsigned long long>(m.proposals), 100.0 * m.acceptance(),
+                   m.bootstrapSeconds,
+                   m.bPrime > 0 ? ("Kelemen weights, b' = " + std::to_string(m.bPrime)).c_str() : "plain splats", static_cast<unsigned long long>(m.proposals), 100.0 * m.acceptance(),
                    m.proposals ? 100.0 * double(m.largeProposals) / double(m.proposals) : 0.0,
                    m.largeProposals ? 100.0 * double(m.largeAccepted) / double(m.largeProposals) : 0.0);
     }
@@ -748,6 +751,10 @@ int runCli(int argc, char** argv) {
       ->capture_default_str()->check(CLI::Range(0.0f, 1.0f));
   render->add_option("--mlt-sigma", ra.mltSigma, "mlt: standard deviation of a small step per primary coordinate")
       ->capture_default_str()->check(CLI::Range(1e-6f, 1.0f));
+  render->add_option("--mlt-weights", ra.mltWeights, "mlt: splat weights: kelemen (large steps also count as "
+                                                     "independent path samples, combined with the chain) or plain "
+                                                     "(expected-value splats only; docs/mlt.md)")
+      ->capture_default_str()->check(CLI::IsMember({"kelemen", "plain"}));
   render->add_option("--vegas-bins", ra.vegasBins, "vegas: bins of each warped axis's density (1 .. 4096)")
       ->capture_default_str();
   render->add_option("--vegas-bounces", ra.vegasBounces, "vegas: bounces whose light choice, light point and BSDF "

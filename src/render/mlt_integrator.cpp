@@ -16,8 +16,9 @@ using shared::Globals;
 
 std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t dims, std::uint32_t bootstrap,
                                       std::uint64_t pixels) {
-  // Current vectors, states, start indices; splat sums; the bootstrap's f values; GpuMlt, counters.
-  return std::uint64_t(shared::primarySampleSlots(chains)) * dims * 8ull + std::uint64_t(chains) * 20 + pixels * 24 +
+  // Current vectors, states, start indices; splat sums; the bootstrap's f values (and the chunk of
+  // b' for Kelemen's weights); GpuMlt, counters.
+  return std::uint64_t(shared::primarySampleSlots(chains)) * dims * 8ull + std::uint64_t(chains) * 24 + pixels * 24 +
          std::uint64_t(bootstrap) * 4 + 256;
 }
 
@@ -41,7 +42,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   vk::Buffer* current = make(std::uint64_t(shared::primarySampleSlots(m_chains)) * m_dims * 8, "mlt current vectors");
   vk::Buffer* state = make(std::uint64_t(m_chains) * 16, "mlt chain states");
   m_splats = make(m_pixels * 24, "mlt splats");
-  m_poolF = make(std::uint64_t(m_poolSize) * 4, "mlt bootstrap");
+  m_poolF = make((std::uint64_t(m_poolSize) + m_chains) * 4, "mlt bootstrap");
   m_start = make(std::uint64_t(m_chains) * 4, "mlt chain starts");
   m_counters = make(MLT_COUNTERS * 4, "mlt counters", true);
   std::memset(m_counters->mapped, 0, MLT_COUNTERS * 4);
@@ -112,6 +113,28 @@ void MltIntegrator::bootstrap() {
     g.chunkPaths = m_chains;
     m_globals.upload();
     traceBetween(MLT_KERNEL_START, MLT_KERNEL_ADOPT, m_chains);
+  }
+  // Kelemen's weights need b', an estimate of b independent of the chains' starts (the weights are
+  // then a fixed function on the chain's space and the estimate stays unbiased; b itself from the
+  // same pool as the starts keeps E[b h(X_0)] = the integral of f h): one more chunk of `chains`
+  // independent paths, pool indices poolSize .. poolSize + chains - 1.
+  m.weights = {0.0f, 0.0f, 0.0f, 0.0f};
+  if (m_settings.mltKelemen && m_settings.mltLargeStep > 0.0f && m_report.b > 0) {
+    m.pool.x = m_poolSize;
+    m.pool.y = m_chains;
+    g.chunkPaths = m_chains;
+    m_globals.upload();
+    traceBetween(MLT_KERNEL_POOL, MLT_KERNEL_RECORD, m_chains);
+    std::vector<float> fb(m_chains);
+    vk::downloadBuffer(m_ctx, *m_poolF, fb.data(), std::uint64_t(m_chains) * 4, std::uint64_t(m_poolSize) * 4);
+    double sum = 0;
+    for (float v : fb) sum += std::max(0.0, double(v));
+    m_report.bPrime = sum / double(m_chains);
+    // Without light in that chunk there is no b' to weigh by: the plain splats (a choice made from
+    // the chunk alone, so the estimate stays unbiased).
+    if (m_report.bPrime > 0)
+      m.weights = {1.0f, static_cast<float>(1.0 / m_report.bPrime), static_cast<float>(1.0 / m_report.b),
+                   m_settings.mltLargeStep};
   }
   // Film value of a splat sum: b x pixels / chains per unit, per iteration (the film divides by
   // its count, the iterations).

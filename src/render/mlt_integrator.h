@@ -31,6 +31,7 @@ namespace nusselt {
 struct MltReport {
   std::uint64_t proposals = 0, accepted = 0, largeProposals = 0, largeAccepted = 0;
   double b = 0;                 // the normalisation: mean luminance of the bootstrap paths
+  double bPrime = 0;            // b' of Kelemen's weights (0: plain splats), from other paths
   std::uint32_t chains = 0, bootstrapPaths = 0, dims = 0;
   std::uint64_t nonzeroBootstrap = 0;  // bootstrap paths with f > 0
   double bootstrapSeconds = 0;  // wall time of the bootstrap (its paths, b, the chains' starts)

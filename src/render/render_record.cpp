@@ -117,6 +117,7 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
       meta.ints.push_back({"nusselt/mltBootstrap", mltBootstrapPaths(r.settings)});
       meta.doubles.push_back({"nusselt/mltLargeStep", r.settings.mltLargeStep});
       meta.doubles.push_back({"nusselt/mltSigma", r.settings.mltSigma});
+      meta.ints.push_back({"nusselt/mltKelemen", r.settings.mltKelemen ? 1 : 0});
     }
     if (r.settings.integrator == IntegratorKind::Vegas) {
       meta.ints.push_back({"nusselt/vegasBins", r.settings.vegasBins});
@@ -202,6 +203,8 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
     r.settings.mltBootstrap = static_cast<std::uint32_t>(findInt(meta, "nusselt/mltBootstrap").value_or(0));
     r.settings.mltLargeStep = static_cast<float>(findDouble(meta, "nusselt/mltLargeStep").value_or(0.3));
     r.settings.mltSigma = static_cast<float>(findDouble(meta, "nusselt/mltSigma").value_or(0.01));
+    // Renders written before the key used the plain weights.
+    r.settings.mltKelemen = findInt(meta, "nusselt/mltKelemen").value_or(0) != 0;
   }
   if (r.settings.integrator == IntegratorKind::Vegas) {
     r.settings.vegasBins = static_cast<std::uint32_t>(findInt(meta, "nusselt/vegasBins").value_or(64));

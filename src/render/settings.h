@@ -177,6 +177,10 @@ struct RenderSettings {
   float mltLargeStep = 0.3f;
   // Standard deviation of a small step's move per coordinate (`--mlt-sigma`; pbrt: 0.01).
   float mltSigma = 0.01f;
+  // Splat weights (`--mlt-weights`): Kelemen et al.'s combination of the chain with its large steps
+  // (each large step's path also counts as an independent path-tracer sample, both weighted by
+  // 1 / (f / b' + p_large)), or the plain expected-value splats (false). docs/mlt.md.
+  bool mltKelemen = true;
   // VEGAS (--integrator vegas, docs/vegas.md). Bins per warped axis (`--vegas-bins`, 1 .. 4096).
   std::uint32_t vegasBins = 64;
   // Bounces whose light choice, light point and BSDF draws are warped (`--vegas-bounces`, 1 ..
