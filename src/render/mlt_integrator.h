@@ -11,6 +11,8 @@
 //   step (per iteration, all chains at once): propose (large step with probability p, else small
 //     step), trace, splat the proposal with weight a and the current state with 1 - a (a =
 //     min(1, f(y) / f(x))), each as L / f, into 64-bit fixed-point sums; accept with probability a.
+//     With Kelemen's weights (the default) both splats are over f / b' + p instead of f, and a
+//     large step's path counts once more as an independent sample (docs/mlt.md).
 //   resolve (per pass): film += (b x pixels / chains) x splats, count += iterations.
 //
 // The estimate is unbiased for any chain length: the start is drawn from the pool in proportion
