@@ -261,6 +261,7 @@ struct GpuMlt {
   uvec4 info;
   uvec4 pool;
   vec4 params;
+  // pool = (first pool index of the chunk, its paths, pool size, the bootstrap's seed).
   // Kelemen's weights: (1 when on, 1 / b' (b' from paths independent of the chains' starts),
   // 1 / b, large-step probability); x = 0: plain expected-value splats.
   vec4 weights;

@@ -53,7 +53,7 @@ void main() {
   if (MLT_KERNEL == MLT_KERNEL_POOL || MLT_KERNEL == MLT_KERNEL_START) {
     if (c >= (MLT_KERNEL == MLT_KERNEL_POOL ? m.pool.y : chains)) return;
     uint i = MLT_KERNEL == MLT_KERNEL_POOL ? m.pool.x + c : m.start.v[c];
-    for (uint d = 0u; d < dims; ++d) primary.v[primarySampleIndex(c, d, dims)] = mltPoolSample(i, d, g.seed);
+    for (uint d = 0u; d < dims; ++d) primary.v[primarySampleIndex(c, d, dims)] = mltPoolSample(i, d, m.pool.w);
   } else if (MLT_KERNEL == MLT_KERNEL_RECORD) {
     if (c >= m.pool.y) return;
     m.poolF.v[m.pool.x + c] = luminance(tracedRadiance(c));

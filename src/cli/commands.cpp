@@ -118,23 +118,16 @@ int renderCommand(const RenderArgs& a) {
   s.guideSpatialThreshold = a.guideSpatial;
   s.guideAlpha = a.guideAlpha;
   s.guideMemory = static_cast<std::uint64_t>(a.guideMemoryMiB * 1048576.0);
-  // What Metropolis renders do not support yet (docs/mlt.md): their chains live on the device
-  // only, so a file cannot continue them; guiding and the variance of a correlated estimate.
+  // What Metropolis renders do not support (docs/mlt.md): guiding and the variance of a correlated
+  // estimate. A resumed one restarts its chains from a new bootstrap (docs/mlt.md, "Resume").
   if (s.integrator == IntegratorKind::Mlt) {
-    if (!a.resume.empty())
-      throw Error("--resume with --integrator mlt: a Metropolis render cannot be resumed (its chains are not in the "
-                  "file; docs/mlt.md)");
     if (s.guiding) throw Error("--integrator mlt with --guiding on: not supported (docs/mlt.md)");
     if (a.variance)
       throw Error("--variance with --integrator mlt: the Metropolis estimate has no per-sample variance (its samples "
                   "are correlated; docs/mlt.md)");
   }
-  // VEGAS renders (docs/vegas.md): the learned tables live on the host and device only, so a file
-  // cannot continue them (a fresh warp would make a resumed render differ from an uninterrupted one).
+  // VEGAS renders (docs/vegas.md): a resumed one learns its tables anew from uniform (docs/vegas.md).
   if (s.integrator == IntegratorKind::Vegas) {
-    if (!a.resume.empty())
-      throw Error("--resume with --integrator vegas: a VEGAS render cannot be resumed (its learned warp is not in the "
-                  "file; docs/vegas.md)");
     if (s.guiding) throw Error("--integrator vegas with --guiding on: not supported (docs/vegas.md)");
   }
   if (s.guiding && !a.resume.empty())

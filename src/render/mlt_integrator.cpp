@@ -49,7 +49,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
   m = GpuMlt{};
   m.info = {m_chains, m_dims, 0u, static_cast<std::uint32_t>(m_pixels)};
-  m.pool = {0u, 0u, m_poolSize, 0u};
+  m.pool = {0u, 0u, m_poolSize, settings.seed};
   m.params = {settings.mltLargeStep, settings.mltSigma, 0.0f, 0.0f};
   m.current = current->address;
   m.state = state->address;
@@ -68,10 +68,14 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
 
 MltIntegrator::~MltIntegrator() = default;
 
-void MltIntegrator::bootstrap() {
+void MltIntegrator::bootstrap(std::uint32_t firstSample) {
   auto t0 = std::chrono::steady_clock::now();
   Globals& g = m_globals.host();
   GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
+  const std::uint32_t seed =
+      firstSample == 0 ? m_settings.seed
+                       : shared::pcg4d(glm::uvec4(m_settings.seed, firstSample, MLT_STREAM_POOL, 0x85ebca6bu)).x;
+  m.pool.w = seed;
   g.chunkFirst = 0;
   g.passSamples = 1;
   g.sampleIndex = 0;
@@ -101,7 +105,7 @@ void MltIntegrator::bootstrap() {
     // hash of (c, seed): the start is drawn in proportion to f_i, independently per chain.
     std::vector<std::uint32_t> start(m_chains);
     for (std::uint32_t c = 0; c < m_chains; ++c) {
-      const glm::uvec4 h = shared::pcg4d(glm::uvec4(c, m_settings.seed, MLT_STREAM_START, 0x9e3779b9u));
+      const glm::uvec4 h = shared::pcg4d(glm::uvec4(c, seed, MLT_STREAM_START, 0x9e3779b9u));
       const double u = (double(h.x >> 8) * 16777216.0 + double(h.y >> 8)) / 281474976710656.0;
       const double target = u * total;
       auto it = std::upper_bound(cdf.begin() + 1, cdf.end(), target);
@@ -162,7 +166,7 @@ void MltIntegrator::readCounters() {
 }
 
 void MltIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples) {
-  if (!m_bootstrapped) bootstrap();
+  if (!m_bootstrapped) bootstrap(sampleIndex);
   Globals& g = m_globals.host();
   GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
   g.chunkFirst = 0;

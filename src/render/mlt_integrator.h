@@ -63,7 +63,10 @@ class MltIntegrator : public PrimarySampleIntegrator {
   const std::vector<float>& bootstrapValues() const { return m_poolValues; }
 
  private:
-  void bootstrap();
+  // The pool, b, b' and the chains' starts, keyed on the seed and the render's first sample index
+  // (0: the seed itself), so that a resumed render's chains restart independently of the first
+  // segment's.
+  void bootstrap(std::uint32_t firstSample);
   // One submission: kernel `before` over n chains, the path tracer's trace of their paths, then
   // kernel `after` (the pool, the chains' starts, every step).
   void traceBetween(std::uint32_t before, std::uint32_t after, std::uint32_t n);

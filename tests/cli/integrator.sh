@@ -29,11 +29,11 @@ line=$("$nusselt" diff "$work/path2.exr" "$work/path.exr")
 if "$nusselt" info "$work/path.exr" | grep -q "integratorName"; then fail "a path render's header names its integrator"; fi
 
 expect_error unknown "unknown integrator" -- --integrator bdpt
-expect_error mlt_resume "cannot be resumed" -- --integrator mlt --resume "$work/path.exr" --spp 2
 expect_error mlt_guiding "not supported" -- --integrator mlt --guiding on
 expect_error mlt_variance "no per-sample variance" -- --integrator mlt --variance
 
-# An mlt render: its header names it; merging it is refused; resuming it with path is refused.
+# An mlt render: its header names it; merging it is refused; resuming it with path is refused,
+# with mlt it continues (the chains restart: docs/mlt.md) to the new spp.
 "$nusselt" render -o "$work/mlt.exr" "${small[@]}" --integrator mlt --mlt-chains 1024 --spp 2 || fail "mlt render"
 [ "$("$nusselt" info "$work/mlt.exr" | sed -n 's/^  nusselt\/integratorName: //p')" = mlt ] || fail "mlt header"
 "$nusselt" render -o "$work/mlt2.exr" "${small[@]}" --integrator mlt --mlt-chains 1024 --spp 2 --spp-offset 2 || fail "mlt render 2"
@@ -44,15 +44,18 @@ cp "$work/mlt.exr" "$work/resume.exr"
 if "$nusselt" render "${small[@]}" --resume "$work/resume.exr" --spp 4 2>"$work/err"; then fail "path resume of an mlt render"
 elif ! grep -qF "integrator" "$work/err"; then fail "resume message: $(cat "$work/err")"
 else echo "ok   mlt_resume_as_path: $(cat "$work/err")"; fi
+"$nusselt" render "${small[@]}" --integrator mlt --mlt-chains 1024 --resume "$work/resume.exr" --spp 4 \
+  || fail "mlt resume"
+[ "$("$nusselt" info "$work/resume.exr" | sed -n 's/^  nusselt\/spp: //p')" = 4 ] || fail "mlt resume: spp in the header"
 
 # vegas: bad options and unsupported combinations are refused; its header names it and its
-# options; merging and resuming it (as vegas or as path) are refused.
+# options; merging it and resuming it as path are refused; resumed as vegas it continues (its tables
+# learned anew: docs/vegas.md).
 expect_error vegas_bins "--vegas-bins 0: between 1 and 4096" -- --integrator vegas --vegas-bins 0
 expect_error vegas_bounces "--vegas-bounces 0" -- --integrator vegas --vegas-bounces 0
 expect_error vegas_bounces_depth "max depth + 1" -- --integrator vegas --vegas-bounces 4 --max-depth 2
 expect_error vegas_alpha "--vegas-alpha" -- --integrator vegas --vegas-alpha 0
 expect_error vegas_guiding "not supported" -- --integrator vegas --guiding on
-expect_error vegas_resume "cannot be resumed" -- --integrator vegas --resume "$work/path.exr" --spp 2
 "$nusselt" render -o "$work/vegas.exr" "${small[@]}" --integrator vegas --spp 4 --samples-per-pass 2 --vegas-bins 16 \
   --variance || fail "vegas render"
 [ "$("$nusselt" info "$work/vegas.exr" | sed -n 's/^  nusselt\/integratorName: //p')" = vegas ] || fail "vegas header"
@@ -67,6 +70,9 @@ cp "$work/vegas.exr" "$work/resume.exr"
 if "$nusselt" render "${small[@]}" --resume "$work/resume.exr" --spp 8 2>"$work/err"; then fail "path resume of a vegas render"
 elif ! grep -qF "integrator" "$work/err"; then fail "resume message: $(cat "$work/err")"
 else echo "ok   vegas_resume_as_path: $(cat "$work/err")"; fi
+"$nusselt" render "${small[@]}" --integrator vegas --samples-per-pass 2 --vegas-bins 16 --variance \
+  --resume "$work/resume.exr" --spp 8 || fail "vegas resume"
+[ "$("$nusselt" info "$work/resume.exr" | sed -n 's/^  nusselt\/spp: //p')" = 8 ] || fail "vegas resume: spp in the header"
 
 [ $fails -eq 0 ] && echo "all integrator checks passed"
 exit $((fails > 0))

@@ -81,6 +81,35 @@ TEST(Mlt, SameSeedIsBitIdenticalOtherSeedIsNot) {
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
+// A resumed render (docs/mlt.md, "Resume"): 5 mutations per chain, saved, then continued to 10 in
+// a new renderer from the saved sums; the second segment bootstraps again (keyed on its first
+// sample index) and restarts its chains. The result must still estimate the path tracer's image:
+// seeds against the reference as the mean tests do.
+TEST(Mlt, ResumedRenderMatchesThePathTracer) {
+  Scene scene = cornell();
+  RenderSettings ps = base(1000);
+  ps.spp = 8192;
+  test::Rendered ref = test::render(scene, ps);
+  std::vector<Image> replicas;
+  for (int k = 0; k < 8; ++k) {
+    RenderSettings ms = mltSettings(50 + k, 4096, 10);
+    ms.mltBootstrap = 1u << 17;
+    Image first;
+    {
+      Renderer r(test::context(), scene, ms);
+      r.render(5);
+      first = r.image();
+    }
+    Renderer r(test::context(), scene, ms);
+    r.restoreAccumulation(first, 5);
+    r.render(10);
+    EXPECT_EQ(r.samplesDone(), 10u);
+    replicas.push_back(r.image());
+  }
+  test::expectReplicasMatchReference(ref.image, replicas, "mlt resumed", "4096 chains x (5 + 5) mutations");
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
 // Kelemen's weights against the plain splats, paired by seed: the same bootstrap (b, starts) and
 // the same chains' random numbers, so b's noise, which dominates a short render, is largely common
 // to both and the difference of their image luminances is a sharp test of the weights' exactness.
