@@ -15,16 +15,8 @@ using namespace nusselt;
 
 namespace {
 
-Scene cornell() { return loadSceneOrDefault("", ""); }
-
-RenderSettings base(std::uint32_t seed) {
-  RenderSettings s;
-  s.width = 16;
-  s.height = 16;
-  s.maxDepth = 5;
-  s.seed = seed;
-  return s;
-}
+Scene cornell() { return test::defaultScene(); }
+RenderSettings base(std::uint32_t seed) { return test::integratorSettings(seed); }
 
 RenderSettings mltSettings(std::uint32_t seed, std::uint32_t chains, std::uint32_t iterations) {
   RenderSettings s = base(seed);

@@ -69,11 +69,11 @@ void lookDown(Scene& s, float height, float mag) {
   s.camera.xmag = s.camera.ymag = mag;
 }
 
-// The 16 x 16, 4 spp render of the exact-value tests below.
-RenderSettings exactSettings(std::uint32_t maxDepth, std::uint32_t seed) {
+// The 16 x 16 render of the tests below: 4 spp for the exact-value tests, more for the statistical ones.
+RenderSettings exactSettings(std::uint32_t maxDepth, std::uint32_t seed, std::uint32_t spp = 4) {
   RenderSettings rs;
   rs.width = rs.height = 16;
-  rs.spp = 4;
+  rs.spp = spp;
   rs.maxDepth = maxDepth;
   rs.seed = seed;
   return rs;
@@ -333,11 +333,7 @@ TEST(TexturesRender, BaseColorAndMetallicRoughnessTexturesGiveThePredictedAlbedo
   addTexturedQuad(s, 0.0f, 0);
   lookDown(s, 1.0f, 1.0f);
   s.background = glm::vec3(1.0f);
-  RenderSettings rs;
-  rs.width = rs.height = 16;
-  rs.spp = 256;
-  rs.maxDepth = 1;
-  rs.seed = 7;
+  RenderSettings rs = exactSettings(1, 7, 256);
   test::Rendered r = test::render(s, rs);
 
   const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 12.0)));
@@ -564,11 +560,7 @@ TEST(TexturesRender, HalfTransparentBlendPassesHalfOfCameraAndShadowRays) {
   const double open = 0.8 / M_PI * 2.0 * l.z;
   const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 6.0)));
   for (Traversal tr : traversals()) {
-    RenderSettings rs;
-    rs.width = rs.height = 16;
-    rs.spp = 64;
-    rs.maxDepth = 1;
-    rs.seed = 13;
+    RenderSettings rs = exactSettings(1, 13, 64);
     rs.traversal = tr;
     test::Rendered r = test::render(s, rs);
     for (int k = 0; k < 3; ++k) {
@@ -596,11 +588,7 @@ TEST(TexturesRender, HalfTransparentBlendPassesHalfOfCameraAndShadowRays) {
 TEST(TexturesRender, GlassSlabTransmitsAsFresnelPredicts) {
   Scene s = test::loadTestScene("scenes/tests/glass_slab.gltf");
   lookDown(s, 1.0f, 0.9f);
-  RenderSettings rs;
-  rs.width = rs.height = 16;
-  rs.spp = 64;
-  rs.maxDepth = 32;
-  rs.seed = 17;
+  RenderSettings rs = exactSettings(32, 17, 64);
   const double R = 0.04;
   expectImageMean(test::render(s, rs), (1 - R) / (1 + R));
 }
@@ -618,11 +606,7 @@ TEST(TexturesRender, ThinSheetTransmitsStraightThrough) {
   addTexturedQuad(s, 0.0f, 1, 6.0f);
   const double theta = M_PI / 3, eta = 1.5;
   obliqueCamera(s, theta);
-  RenderSettings rs;
-  rs.width = rs.height = 16;
-  rs.spp = 64;
-  rs.maxDepth = 8;
-  rs.seed = 19;
+  RenderSettings rs = exactSettings(8, 19, 64);
   const double R1 = fresnelUnpolarised(theta, eta);
   expectImageMean(test::render(s, rs), (1 - R1) / (1 + R1));
 }
@@ -649,11 +633,7 @@ TEST(TexturesRender, AbsorbingSlabTransmitsFresnelTimesBeerLambert) {
   addTexturedQuad(s, 0.2f, 0, 6.0f, true);
   addTexturedQuad(s, 0.0f, 1, 6.0f);
   obliqueCamera(s, theta);
-  RenderSettings rs;
-  rs.width = rs.height = 16;
-  rs.spp = 64;
-  rs.maxDepth = 12;
-  rs.seed = 23;
+  RenderSettings rs = exactSettings(12, 23, 64);
   double ct;
   const double R = fresnelUnpolarised(theta, eta, &ct);
   glm::dvec3 expected;
@@ -672,11 +652,7 @@ TEST(TexturesRender, AbsorbingSlabTransmitsFresnelTimesBeerLambert) {
 TEST(TexturesRender, TintedGlassSlabFromGltfTransmitsFresnelTimesAttenuationColor) {
   Scene s = test::loadTestScene("scenes/tests/glass_slab_tinted.gltf");
   lookDown(s, 1.0f, 0.9f);
-  RenderSettings rs;
-  rs.width = rs.height = 16;
-  rs.spp = 64;
-  rs.maxDepth = 32;
-  rs.seed = 31;
+  RenderSettings rs = exactSettings(32, 31, 64);
   const double R = 0.04;
   const glm::dvec3 c(0.8, 0.5, 0.2);
   glm::dvec3 expected;
@@ -707,11 +683,7 @@ TEST(TexturesRender, TransmissionTextureScalesTheTransmittedLight) {
   addTexturedQuad(s, 0.3f, 0);
   addTexturedQuad(s, 0.0f, 1, 2.0f);
   lookDown(s, 1.0f, 0.9f);
-  RenderSettings rs;
-  rs.width = rs.height = 16;
-  rs.spp = 64;
-  rs.maxDepth = 4;
-  rs.seed = 29;
+  RenderSettings rs = exactSettings(4, 29, 64);
   // The gltf_pbr component reflects nothing here (no light above the sheet): no sampling tables
   // needed for it (the quadtree's would take seconds to build).
   rs.sampler = SamplerKind::Cosine;

@@ -16,16 +16,8 @@ using namespace nusselt;
 
 namespace {
 
-Scene cornell() { return loadSceneOrDefault("", ""); }
-
-RenderSettings base(std::uint32_t seed) {
-  RenderSettings s;
-  s.width = 16;
-  s.height = 16;
-  s.maxDepth = 5;
-  s.seed = seed;
-  return s;
-}
+Scene cornell() { return test::defaultScene(); }
+RenderSettings base(std::uint32_t seed) { return test::integratorSettings(seed); }
 
 // spp samples in passes of 16 (a table learned after each: 4096 paths per pass); two warped
 // bounces (10 axes: more of the warp under test than the default's 5).

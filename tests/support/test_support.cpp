@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cli/cli_common.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
 
@@ -118,6 +119,17 @@ double studentTail(double t, double nu) {
   double sum = f(a) + f(b);
   for (int i = 1; i < n; ++i) sum += f(a + (b - a) * i / n) * (i % 2 ? 4 : 2);
   return sum * (b - a) / (3 * n);
+}
+
+Scene defaultScene() { return loadSceneOrDefault("", ""); }
+
+RenderSettings integratorSettings(std::uint32_t seed) {
+  RenderSettings s;
+  s.width = 16;
+  s.height = 16;
+  s.maxDepth = 5;
+  s.seed = seed;
+  return s;
 }
 
 double expectReplicasMatchReference(const Image& reference, const std::vector<Image>& replicas, const std::string& what,

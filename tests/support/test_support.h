@@ -41,6 +41,10 @@ Rendered render(const Scene& scene, const RenderSettings& settings);
 void blockMeans(const Image& img, std::vector<double>& mean, std::vector<double>* var);
 // Upper tail P(T > t) of Student's t with nu degrees of freedom.
 double studentTail(double t, double nu);
+// The default scene (the Cornell box), and the 16 x 16, max depth 5 settings of the integrator
+// tests (test_mlt, test_vegas) with `seed`.
+Scene defaultScene();
+RenderSettings integratorSettings(std::uint32_t seed);
 // Independent replicas (renders with different seeds) of an estimator whose per-pixel variance the
 // film cannot give (Metropolis, VEGAS: a render's samples are correlated) against a path-traced
 // reference: per 4 x 4 block and for the image (blockMeans), Student t with the replicas' sample
