@@ -350,3 +350,19 @@ bool sampleLight(vec3 x, float uSelect, vec2 uPoint, out LightSample ls) {
   ls.value = light.intensity.xyz * (falloff / (dist2 * pSelect));
   return falloff > 0.0f;
 }
+
+// ---- Deterministic sums ------------------------------------------------------------------------
+
+// Adds x (>= 0, x * scale < 2^64) to the 64-bit fixed-point integer words[at] (low word) and
+// words[at + 1] (high word) of `scale` units per unit (a power of two, so every step below is
+// exact): the carry of the low word goes to the high word. Integer additions commute, so many
+// invocations' adds give the same sum in any order (the Metropolis and VEGAS splats).
+void atomicAddFixed64(Uints words, uint at, float x, float scale) {
+  float hiUnit = 4294967296.0f / scale;  // one unit of the high word
+  uint hi = uint(floor(x * (scale * (1.0f / 4294967296.0f))));
+  float rest = x - float(hi) * hiUnit;
+  uint lo = uint(min(rest * scale + 0.5f, 4294967040.0f));
+  uint old = atomicAdd(words.v[at], lo);
+  uint carry = old + lo < old ? 1u : 0u;
+  if (hi + carry != 0u) atomicAdd(words.v[at + 1u], hi + carry);
+}

@@ -21,19 +21,9 @@ vec3 tracedRadiance(uint c) {
   return max(L, vec3(0.0f));
 }
 
-// Adds v (>= 0, < 2^8 per channel) to a pixel's fixed-point sums: a 64-bit integer per channel
-// as two uints, the carry of the low word added to the high word.
+// Adds v (>= 0, < 2^8 per channel) to a pixel's fixed-point sums (a 64-bit integer per channel).
 void splat(GpuMlt m, uint pixel, vec3 v) {
-  for (uint ch = 0u; ch < 3u; ++ch) {
-    float x = min(v[ch], 255.0f);
-    uint hi = uint(floor(x * (1.0f / 256.0f)));           // units of 2^32 / MLT_FIXED_SCALE = 256
-    float rest = x - float(hi) * 256.0f;
-    uint lo = uint(min(rest * MLT_FIXED_SCALE + 0.5f, 4294967040.0f));
-    uint at = (pixel * 3u + ch) * 2u;
-    uint old = atomicAdd(m.splats.v[at], lo);
-    uint carry = old + lo < old ? 1u : 0u;
-    if (hi + carry != 0u) atomicAdd(m.splats.v[at + 1u], hi + carry);
-  }
+  for (uint ch = 0u; ch < 3u; ++ch) atomicAddFixed64(m.splats, (pixel * 3u + ch) * 2u, min(v[ch], 255.0f), MLT_FIXED_SCALE);
 }
 
 // Adds n subgroup-wide to counter k (one atomic per subgroup).

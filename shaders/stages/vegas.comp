@@ -12,16 +12,6 @@
 
 layout(constant_id = 13) const uint VEGAS_KERNEL = 0u;
 
-// Adds v (>= 0, <= VEGAS_SUM_CLAMP) to a 64-bit fixed-point sum (low word at `at`, high at + 1).
-void addFixed(Uints sums, uint at, float v) {
-  float x = min(v, VEGAS_SUM_CLAMP);
-  uint hi = uint(floor(x * (1.0f / 65536.0f)));  // units of 2^32 / VEGAS_FIXED_SCALE = 65536
-  float rest = x - float(hi) * 65536.0f;
-  uint lo = uint(min(rest * VEGAS_FIXED_SCALE + 0.5f, 4294967040.0f));
-  uint old = atomicAdd(sums.v[at], lo);
-  uint carry = old + lo < old ? 1u : 0u;
-  if (hi + carry != 0u) atomicAdd(sums.v[at + 1u], hi + carry);
-}
 
 void main() {
   uint i = gl_GlobalInvocationID.x;
@@ -67,7 +57,7 @@ void main() {
     Uints sums = V.sums;
     for (uint a = 0u; a < axes; ++a) {
       float x = primary.v[primarySampleIndex(i, vegasAxisDimension(a), dims)][vegasAxisComponent(a)];
-      addFixed(sums, (a * bins + vegasBin(x, bins)) * 2u, F * F);
+      atomicAddFixed64(sums, (a * bins + vegasBin(x, bins)) * 2u, min(F * F, VEGAS_SUM_CLAMP), VEGAS_FIXED_SCALE);
     }
   }
 }
