@@ -10,6 +10,9 @@
 # counts mutations per chain), and the ratio
 # path / integrator of the medians' relMSE x s (> 1: the integrator wins). The reference's own
 # noise adds the same amount to both relMSEs (give REF_SPP ~10x what a run reaches).
+# A scene written SCENE@x0,y0,x1,y1 is also measured in that region of its image (fractions of the
+# width and height from the top left, `nusselt diff --region`): its relMSE, relMSE x s and ratio
+# are printed for the region as well (e.g. the caustic under the glass sphere).
 #
 #   tools/bench_integrator.sh mlt|vegas [DIR] [NUSSELT]
 # tools/bench_mlt.sh and tools/bench_vegas.sh call it with their integrator's default scenes.
@@ -39,13 +42,16 @@ attr() { "$bin" info "$1" | sed -n "s/^  nusselt\/$2: //p" | head -1; }
 echo "bench_integrator: $integrator against path, ${size}x${size}, --time $budget per run, reference $refSpp spp (path)," \
      "max depth $depth, $repeats repeats, $integrator with: ${ARGS:-(defaults)}"
 echo "device: $("$bin" devices | head -1)"
-for scene in $scenes; do
+for entry in $scenes; do
+  scene=${entry%%@*}
+  region=""
+  [ "$scene" != "$entry" ] && region=${entry#*@}
   name=$(scene_name "$scene")
   sceneArg=$(scene_arg "$scene")
   ref="$dir/$name-ref-$size-$refSpp-$depth.exr"
   # shellcheck disable=SC2086
   bench_reference "$bin" "$scene" "$ref" "$refSpp" $common
-  for mode in path "$integrator"; do : > "$dir/$name.$mode"; done
+  for mode in path "$integrator"; do : > "$dir/$name.$mode"; : > "$dir/$name.$mode.region"; done
   for ((r = 1; r <= repeats; r++)); do
     for mode in path "$integrator"; do
       out="$dir/$name-$mode-$r.exr"
@@ -64,6 +70,12 @@ for scene in $scenes; do
       printf "%-14s %-5s seed %d: relMSE %.5g  %.2f s  %d spp  %.3f Mpaths/s  relMSE x s %.5g  relMSE x spp %.4g\n" \
         "$name" "$mode" "$r" "$rel" "$sec" "$spp" "$rate" "$prod" "$perPath"
       echo "$rel $sec $prod $rate $perPath" >> "$dir/$name.$mode"
+      if [ -n "$region" ]; then
+        relR=$("$bin" diff --region "$region" "$out" "$ref" | awk '{print $2}')
+        printf "%-14s %-5s seed %d: region %s relMSE %.5g  relMSE x s %.5g\n" "$name" "$mode" "$r" "$region" "$relR" \
+          "$(calc "$relR * $sec")"
+        echo "$relR $(calc "$relR * $sec")" >> "$dir/$name.$mode.region"
+      fi
     done
   done
   for mode in path "$integrator"; do
@@ -78,4 +90,13 @@ for scene in $scenes; do
   done
   printf "%-14s path / %s (relMSE x s): %.3f\n" "$name" "$integrator" \
     "$(calc "$(cat "$dir/$name.path.median") / $(cat "$dir/$name.$integrator.median")")"
+  if [ -n "$region" ]; then
+    for mode in path "$integrator"; do
+      printf "%-14s %-5s region %s median: relMSE %.5g  relMSE x s %.5g\n" "$name" "$mode" "$region" \
+        "$(awk '{print $1}' "$dir/$name.$mode.region" | median)" "$(awk '{print $2}' "$dir/$name.$mode.region" | median)"
+      awk '{print $2}' "$dir/$name.$mode.region" | median > "$dir/$name.$mode.region.median"
+    done
+    printf "%-14s region %s path / %s (relMSE x s): %.3f\n" "$name" "$region" "$integrator" \
+      "$(calc "$(cat "$dir/$name.path.region.median") / $(cat "$dir/$name.$integrator.region.median")")"
+  fi
 done

@@ -575,8 +575,34 @@ int infoCommand(const std::vector<std::string>& files) {
   return kExitOk;
 }
 
-int diffCommand(const std::string& a, const std::string& b) {
+int diffCommand(const std::string& a, const std::string& b, const std::string& regionText) {
+  std::vector<double> region;
+  if (!regionText.empty()) {
+    std::size_t at = 0;
+    while (at <= regionText.size()) {
+      std::size_t comma = std::min(regionText.find(',', at), regionText.size());
+      const std::string part = regionText.substr(at, comma - at);
+      std::size_t used = 0;
+      double v = 0;
+      try {
+        v = std::stod(part, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (part.empty() || used != part.size())
+        throw Error("--region '" + regionText + "': '" + part + "' is not a number (expected x0,y0,x1,y1)");
+      region.push_back(v);
+      at = comma + 1;
+    }
+    if (region.size() != 4)
+      throw Error("--region '" + regionText + "': expected four fractions x0,y0,x1,y1, got " + std::to_string(region.size()));
+  }
   Image ia = readExr(a), ib = readExr(b);
+  if (!region.empty()) {
+    if (ia.width != ib.width || ia.height != ib.height) compareImages(ia, ib);  // its size error, before cropping
+    ia = cropImage(ia, region[0], region[1], region[2], region[3], "--region");
+    ib = cropImage(ib, region[0], region[1], region[2], region[3], "--region");
+  }
   ImageDifference d = compareImages(ia, ib);
   std::printf("relMSE %.6g  MSE %.6g  mean %.6g (%s) vs %.6g (%s)  max |diff| %.6g\n", d.relMse, d.mse, d.meanA,
               a.c_str(), d.meanB, b.c_str(), d.maxAbs);
@@ -842,6 +868,10 @@ int runCli(int argc, char** argv) {
   CLI::App* diff = app.add_subcommand("diff", "Compare two EXR images: relMSE (reference = second), MSE, means, max difference");
   diff->add_option("image", diffA, "Image")->required();
   diff->add_option("reference", diffB, "Reference image")->required();
+  std::string diffRegion;
+  diff->add_option("--region", diffRegion,
+                   "Compare only the region x0,y0,x1,y1, fractions of the width and height from the top left "
+                   "(e.g. 0.25,0.5,0.75,1 for the middle of the lower half)");
 
   CommandRunner run;
   registerSamplerCommands(app, *bench, run);
@@ -866,7 +896,7 @@ int runCli(int argc, char** argv) {
     if (*info) return infoCommand(infoFiles);
     if (*merge) return mergeCommand(mergeInputs, mergeOutput);
     if (*albedo) return albedoCommand(aa);
-    if (*diff) return diffCommand(diffA, diffB);
+    if (*diff) return diffCommand(diffA, diffB, diffRegion);
   } catch (const Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return kExitFailure;

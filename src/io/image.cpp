@@ -507,4 +507,24 @@ ImageDifference compareImages(const Image& a, const Image& reference) {
   return d;
 }
 
+Image cropImage(const Image& image, double x0, double y0, double x1, double y1, const std::string& what) {
+  auto fraction = [](double v) { return std::isfinite(v) && v >= 0.0 && v <= 1.0; };
+  if (!fraction(x0) || !fraction(y0) || !fraction(x1) || !fraction(y1) || !(x0 < x1) || !(y0 < y1))
+    throw Error(what + ": expected fractions 0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1 of the image, got " +
+                std::to_string(x0) + "," + std::to_string(y0) + "," + std::to_string(x1) + "," + std::to_string(y1));
+  if (image.width <= 0 || image.height <= 0 || image.rgb.size() != std::size_t(3) * image.width * image.height)
+    throw Error(what + ": the image is empty or its size does not match its pixels");
+  // Every pixel the fractions touch: floor(x0 w) < ceil(x1 w) <= w when x0 < x1 <= 1.
+  int px0 = int(std::floor(x0 * image.width)), px1 = int(std::ceil(x1 * image.width));
+  int py0 = int(std::floor(y0 * image.height)), py1 = int(std::ceil(y1 * image.height));
+  Image out;
+  out.width = px1 - px0;
+  out.height = py1 - py0;
+  out.rgb.reserve(std::size_t(3) * out.width * out.height);
+  for (int y = py0; y < py1; ++y)
+    for (int x = px0; x < px1; ++x)
+      for (int c = 0; c < 3; ++c) out.rgb.push_back(image.rgb[(std::size_t(y) * image.width + x) * 3 + c]);
+  return out;
+}
+
 }  // namespace nusselt

@@ -86,4 +86,10 @@ struct ImageDifference {
 };
 ImageDifference compareImages(const Image& a, const Image& reference);
 
+// The pixels an image's region [x0, x1) x [y0, y1) touches, given as fractions of its width and
+// height (0 <= x0 < x1 <= 1, likewise y; at least one pixel): a region of interest that means the
+// same part of the picture at any resolution (`nusselt diff --region`). Throws nusselt::Error on
+// fractions out of range or in the wrong order; `what` names them in the message.
+Image cropImage(const Image& image, double x0, double y0, double x1, double y1, const std::string& what = "region");
+
 }  // namespace nusselt

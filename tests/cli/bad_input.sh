@@ -70,5 +70,17 @@ else
   echo "FAIL degenerate: exit status $?: $(cat "$work/stderr")"; fails=$((fails + 1))
 fi
 
+# nusselt diff --region: a malformed region is a usage error naming the option, never a crash.
+"$nusselt" render -o "$work/small.exr" --spp 1 --width 8 --height 8 -q || { echo "FAIL diff: no image"; fails=$((fails + 1)); }
+for region in 0.5,0.5 0.1,0.1,0.2,0.3,0.4 0.5,0,0.2,1 nan,0,1,1 0,x,1,1 -0.1,0,1,1; do
+  "$nusselt" diff --region "$region" "$work/small.exr" "$work/small.exr" >"$work/stdout" 2>"$work/stderr"
+  status=$?
+  if [ $status -eq 0 ] || [ $status -ge 128 ] || ! grep -qF -- "--region" "$work/stderr"; then
+    echo "FAIL diff_region $region: exit status $status: $(cat "$work/stderr")"; fails=$((fails + 1))
+  else echo "ok   diff_region $region: $(cat "$work/stderr")"; fi
+done
+line=$("$nusselt" diff --region 0.25,0.5,0.75,1 "$work/small.exr" "$work/small.exr")
+[[ "$line" == relMSE\ 0\ * ]] || { echo "FAIL diff_region: a region of an image against itself: $line"; fails=$((fails + 1)); }
+
 [ $fails -eq 0 ] && echo "all bad-input cases behave" || echo "$fails bad-input cases misbehave"
 exit $((fails > 0))

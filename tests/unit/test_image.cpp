@@ -427,6 +427,37 @@ TEST(ImageCompare, KnownInputs) {
   errorOf([&] { compareImages(a, broken); });
 }
 
+TEST(ImageCompare, RegionCropsTheTouchedPixels) {
+  // A 4 x 2 image whose pixel (x, y) holds x + 10 y in every channel.
+  Image im;
+  im.width = 4;
+  im.height = 2;
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 4; ++x)
+      for (int c = 0; c < 3; ++c) im.rgb.push_back(float(x + 10 * y));
+  auto firstColumnRow = [](const Image& c) { return std::make_pair(c.rgb.front(), c.rgb.back()); };
+  // The right half of the lower row: pixels (2, 1) and (3, 1).
+  Image c = cropImage(im, 0.5, 0.5, 1.0, 1.0);
+  EXPECT_EQ(c.width, 2);
+  EXPECT_EQ(c.height, 1);
+  EXPECT_EQ(firstColumnRow(c), std::make_pair(12.0f, 13.0f));
+  // Fractions between pixel edges take every pixel they touch: x in [0.3, 0.55) -> pixels 1 and 2.
+  c = cropImage(im, 0.3, 0.0, 0.55, 0.2);
+  EXPECT_EQ(c.width, 2);
+  EXPECT_EQ(c.height, 1);
+  EXPECT_EQ(firstColumnRow(c), std::make_pair(1.0f, 2.0f));
+  // The whole image is itself.
+  EXPECT_EQ(cropImage(im, 0, 0, 1, 1).rgb, im.rgb);
+  // Out of range, reversed or NaN fractions name the option.
+  EXPECT_NE(errorOf([&] { cropImage(im, 0.5, 0, 0.5, 1, "--region"); }).find("--region"), std::string::npos);
+  errorOf([&] { cropImage(im, -0.1, 0, 0.5, 1); });
+  errorOf([&] { cropImage(im, 0, 0, 1.5, 1); });
+  errorOf([&] { cropImage(im, 0, std::nan(""), 1, 1); });
+  Image broken = im;
+  broken.rgb.pop_back();
+  errorOf([&] { cropImage(broken, 0, 0, 1, 1); });
+}
+
 TEST(Progress, FormatDuration) {
   EXPECT_EQ(formatDuration(0), "0:00");
   EXPECT_EQ(formatDuration(4.2), "0:04");
