@@ -256,7 +256,8 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer Environment
 // current: the chains' current vectors (primarySampleIndex(c, d, dims)); state: per chain (its current
 // radiance L (rgb), its pixel as float bits); splats: per pixel 6 uints (r, g, b: low, high);
 // poolF: f of every bootstrap path; start: the pool path each chain starts from; counters:
-// MLT_COUNTERS uints, per pass.
+// MLT_COUNTERS uints, per pass; extent: per chain, the draws its current path read (mltExtent of
+// the path's bounces, mlt.h): a small step moves those and draws the rest fresh.
 struct GpuMlt {
   uvec4 info;
   uvec4 pool;
@@ -271,8 +272,10 @@ struct GpuMlt {
   BUFREF(Floats) poolF;
   BUFREF(Uints) start;
   BUFREF(Uints) counters;
+  BUFREF(Uints) extent;
+  uvec2 reserved;  // std430 rounds the struct to 16 bytes
 };
-STATIC_ASSERT_SIZE(GpuMlt, 112);
+STATIC_ASSERT_SIZE(GpuMlt, 128);
 #ifndef __cplusplus
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Mlts { GpuMlt v[]; };
 #endif
@@ -339,7 +342,7 @@ struct Globals {
   BUFREF(Vec4s) pathThroughput;// per path: throughput (rgb), w = etaScale (the product of (n_t / n_i)^2 over
                                // refractions, which undoes their radiance scaling for the roulette)
   BUFREF(Vec4s) pathRadiance;  // per path: radiance gathered so far (rgb)
-  BUFREF(UVec4s) pathInfo;     // per path: (pixel, sample index, 0, 0)
+  BUFREF(UVec4s) pathInfo;     // per path: (pixel, sample index, bounces shaded (PRIMARY_SAMPLES stages only), 0)
   BUFREF(Vec4s) pathHit;       // per path: (t, b1, b2, triangle bits)
   BUFREF(Vec4s) shadowOrigin;  // per path: shadow ray origin, w = tmax
   BUFREF(Vec4s) shadowDirection;

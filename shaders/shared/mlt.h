@@ -5,11 +5,11 @@
 // A chain's state is a primary sample vector: the 2-D draws of a path (stage_common.glsl,
 // pathSample2), which the path tracer turns into a path and its radiance L. Each step proposes a
 // new vector, either a large step (every draw fresh and uniform: an independent path) with
-// probability largeStep, or a small step (every coordinate moved by a normal deviate of standard
-// deviation sigma, wrapped around the unit interval). Both proposals are symmetric, q(x -> y) =
-// q(y -> x) (a large step's density is 1 either way; a small step's depends only on the wrapped
-// difference, whose distribution is symmetric about 0), so the acceptance is
-// min(1, f(y) / f(x)) with f = luminance(L).
+// probability largeStep, or a small step (every coordinate the current path read moved by a normal
+// deviate of standard deviation sigma, wrapped around the unit interval; the others fresh:
+// mltExtent). Both proposals are symmetric, q(x -> y) = q(y -> x) (a large step's density is 1
+// either way; a small step's depends only on the wrapped difference, whose distribution is
+// symmetric about 0), so the acceptance is min(1, f(y) / f(x)) with f = luminance(L).
 #ifndef NUSSELT_MLT_H
 #define NUSSELT_MLT_H
 #include "prelude.h"
@@ -68,12 +68,24 @@ SHARED_FN vec2 mltSmallStep(vec2 u, uvec4 h, float sigma) {
   return vec2(mltWrap(u.x + r * cos(a)), mltWrap(u.y + r * sin(a)));
 }
 
+// The draws a path with `bounces` shaded vertices read: the camera's (dimensions 0 and 1) and each
+// shaded bounce's RNG_DIMS_PER_BOUNCE (rng.h; the shade stage records the bounces), at most dims.
+// A small step moves these draws of the current vector and draws every later one fresh, as a large
+// step does. That is the same chain, in law, as moving every draw: f does not depend on draws the
+// current path did not read, so under the chain's target their conditional law is uniform, and
+// redrawing them uniformly is a Gibbs step that leaves the target invariant (which draws it
+// redraws depends only on the draws the path read, which it keeps); the small step then moves
+// uniform draws to uniform draws. What it saves: the normal deviates and the copies of every draw
+// a short path never reads.
+SHARED_FN uint mltExtent(uint bounces, uint dims) { return min(rngDimension(bounces, 0u), dims); }
+
 // The large step's draw: fresh uniforms from h.z, h.w.
 SHARED_FN vec2 mltLargeStep(uvec4 h) { return vec2(mltUnit(h.z), mltUnit(h.w)); }
 
-// The proposal for draw u of a step (large or small) with that draw's hash h.
-SHARED_FN vec2 mltPropose(vec2 u, uvec4 h, bool large, float sigma) {
-  return large ? mltLargeStep(h) : mltSmallStep(u, h, sigma);
+// The proposal for draw u of a step with that draw's hash h: fresh (a large step, or a draw the
+// current path did not read: mltExtent) or moved by the small step.
+SHARED_FN vec2 mltPropose(vec2 u, uvec4 h, bool fresh, float sigma) {
+  return fresh ? mltLargeStep(h) : mltSmallStep(u, h, sigma);
 }
 
 SHARED_END

@@ -49,14 +49,20 @@ void main() {
     m.poolF.v[m.pool.x + c] = luminance(tracedRadiance(c));
   } else if (MLT_KERNEL == MLT_KERNEL_ADOPT) {
     if (c >= chains) return;
-    for (uint d = 0u; d < dims; ++d) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];
+    uint extent = mltExtent(g.pathInfo.v[c].z, dims);
+    for (uint d = 0u; d < extent; ++d) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];
     m.state.v[c] = vec4(tracedRadiance(c), uintBitsToFloat(g.pathInfo.v[c].x));
+    m.extent.v[c] = extent;
   } else if (MLT_KERNEL == MLT_KERNEL_MUTATE) {
     if (c >= chains) return;
     bool large = mltUnit(mltHash(c, iteration, MLT_DIM_STEP, g.seed).x) < m.params.x;
-    for (uint d = 0u; d < dims; ++d)
-      primary.v[primarySampleIndex(c, d, dims)] =
-          mltPropose(m.current.v[primarySampleIndex(c, d, dims)], mltHash(c, iteration, d, g.seed), large, m.params.y);
+    // A small step moves the draws the current path read and draws the rest fresh (mltExtent).
+    uint moved = large ? 0u : m.extent.v[c];
+    for (uint d = 0u; d < dims; ++d) {
+      uint at = primarySampleIndex(c, d, dims);
+      uvec4 h = mltHash(c, iteration, d, g.seed);
+      primary.v[at] = mltPropose(d < moved ? m.current.v[at] : vec2(0.0f), h, d >= moved, m.params.y);
+    }
   } else if (MLT_KERNEL == MLT_KERNEL_ACCEPT) {
     bool live = c < chains;
     bool large = false, accepted = false;
@@ -84,9 +90,11 @@ void main() {
         if (fc > 0.0f && a < 1.0f) splat(m, floatBitsToUint(state.w), Lc * ((1.0f - a) / fc));
       }
       accepted = mltUnit(h.y) < a;
-      if (accepted) {
-        for (uint d = 0u; d < dims; ++d) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];
+      if (accepted) {  // the draws the new path read: the next step draws the others fresh
+        uint extent = mltExtent(g.pathInfo.v[c].z, dims);
+        for (uint d = 0u; d < extent; ++d) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];
         m.state.v[c] = vec4(Lp, uintBitsToFloat(pp));
+        m.extent.v[c] = extent;
       }
     }
     count(m, 0u, live);

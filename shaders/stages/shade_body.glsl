@@ -404,6 +404,9 @@ void main() {
   if (idx >= queueCount(queue)) return;
   uint path = queueItem(queue, idx);
   uint bounce = pc.bounce;
+  // With primary samples, the bounces this path has shaded: a Metropolis chain moves the draws its
+  // path read (mlt.h, mltExtent).
+  if (PRIMARY_SAMPLES) g.pathInfo.v[path].z = bounce + 1u;
   PathKey key = pathKey(path);  // every draw: pathSample1/2(key, dimension) (stage_common.glsl)
   uint lighting = g.lighting;
   uint roulette = g.roulette;

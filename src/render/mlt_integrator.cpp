@@ -16,9 +16,9 @@ using shared::Globals;
 
 std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t dims, std::uint32_t bootstrap,
                                       std::uint64_t pixels) {
-  // Current vectors, states, start indices; splat sums; the bootstrap's f values (and the chunk of
+  // Current vectors, states, start indices, extents; splat sums; the bootstrap's f values (and the chunk of
   // b' for Kelemen's weights); GpuMlt, counters.
-  return std::uint64_t(shared::primarySampleSlots(chains)) * dims * 8ull + std::uint64_t(chains) * 24 + pixels * 24 +
+  return std::uint64_t(shared::primarySampleSlots(chains)) * dims * 8ull + std::uint64_t(chains) * 28 + pixels * 24 +
          std::uint64_t(bootstrap) * 4 + 256;
 }
 
@@ -44,6 +44,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m_splats = make(m_pixels * 24, "mlt splats");
   m_poolF = make((std::uint64_t(m_poolSize) + m_chains) * 4, "mlt bootstrap");
   m_start = make(std::uint64_t(m_chains) * 4, "mlt chain starts");
+  vk::Buffer* extent = make(std::uint64_t(m_chains) * 4, "mlt chain extents");
   m_counters = make(MLT_COUNTERS * 4, "mlt counters", true);
   std::memset(m_counters->mapped, 0, MLT_COUNTERS * 4);
   GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
@@ -57,6 +58,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m.poolF = m_poolF->address;
   m.start = m_start->address;
   m.counters = m_counters->address;
+  m.extent = extent->address;
   globals.host().mlt = m_mlt->address;
 
   VkCommandBuffer cmd = vk::beginOneShot(m_ctx);

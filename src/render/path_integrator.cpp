@@ -67,7 +67,8 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   g.pathThroughput = make(cap * 16, "path throughput")->address;
   m_pathRadiance = make(cap * 16, "path radiance");
   g.pathRadiance = m_pathRadiance->address;
-  g.pathInfo = make(cap * 16, "path info")->address;
+  m_pathInfo = make(cap * 16, "path info");
+  g.pathInfo = m_pathInfo->address;
   g.pathHit = make(cap * 16, "path hit")->address;
   g.shadowOrigin = make(cap * 16, "shadow ray origin")->address;
   g.shadowDirection = make(cap * 16, "shadow ray direction")->address;

@@ -77,6 +77,8 @@ class PathIntegrator : public Integrator {
   std::uint32_t capacity() const { return m_capacity; }
   // Per path slot: the radiance of its last traced path (rgb).
   const vk::Buffer& pathRadiance() const { return *m_pathRadiance; }
+  // Per path slot: (pixel, sample index, bounces shaded (with primary samples), 0) (layout.h).
+  const vk::Buffer& pathInfo() const { return *m_pathInfo; }
   // primarySampleSlots(capacity()) x PathOptions::primaryDims vec2s (only when primaryDims > 0).
   vk::Buffer& primarySamples() { return *m_primarySamples; }
 
@@ -109,6 +111,7 @@ class PathIntegrator : public Integrator {
   bool m_hasAlpha = false;     // spec constant HAS_ALPHA of the tracing stages
   DeviceGuide* m_guide = nullptr;  // path guiding (guide.h): its records are read after every chunk
   vk::Buffer* m_pathRadiance = nullptr;
+  vk::Buffer* m_pathInfo = nullptr;
   PathOptions m_options;
   vk::Buffer* m_primarySamples = nullptr;
   std::vector<vk::ComputePipeline> m_shade;  // one per slot

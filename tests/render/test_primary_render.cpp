@@ -4,6 +4,7 @@
 // bit for bit; slots with different vectors trace different paths.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstring>
 #include <random>
 
@@ -11,6 +12,7 @@
 #include "cli/cli_common.h"
 #include "render/path_integrator.h"
 #include "../../shaders/shared/layout.h"
+#include "../../shaders/shared/mlt.h"
 
 using namespace nusselt;
 
@@ -63,5 +65,70 @@ TEST(PrimaryRender, SameVectorSamePathOtherVectorOtherPath) {
   // lead to the same constant value; at most 10 % of the pairs, far above what 16x16 Cornell pixels
   // put on the light (about 2 %).
   EXPECT_LE(otherEqual, otherNonzero / 10) << "different primary vectors gave the same radiance";
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// A Metropolis small step moves only the draws its current path read and draws the others fresh
+// (mlt.h, mltExtent of the bounces the shade stage records in pathInfo.z). That is exact only if
+// the recorded extent covers every draw the path read: here every draw beyond it is replaced and
+// the path must not change, bit for bit; replacing the last shaded bounce's light-point draw (read
+// by its light sample) must change most paths, so an extent one bounce short would fail.
+TEST(PrimaryRender, DrawsBeyondTheRecordedExtentAreNotRead) {
+  Scene scene = loadSceneOrDefault("", "");
+  RenderSettings s;
+  s.width = 16;
+  s.height = 16;
+  s.spp = 1;
+  s.samplesPerPass = 1;
+  s.maxDepth = 5;
+  s.seed = 5;
+  s.primarySamples = true;
+  Renderer r(test::context(), scene, s);
+  PathIntegrator& paths = r.paths();
+  const std::uint32_t dims = PathIntegrator::primaryDimsFor(s.maxDepth);
+  const std::uint32_t slots = s.width * s.height;
+  std::mt19937 prng(17);
+  auto fresh = [&] { return glm::vec2(float(prng() >> 8), float(prng() >> 8)) * (1.0f / 16777216.0f); };
+  std::vector<glm::vec2> u(std::size_t(shared::primarySampleSlots(paths.capacity())) * dims);
+  for (glm::vec2& x : u) x = fresh();
+  auto trace = [&](const std::vector<glm::vec2>& v, std::vector<glm::vec4>& L, std::vector<glm::uvec4>& info) {
+    vk::uploadBuffer(test::context(), paths.primarySamples(), v.data(), v.size() * 8);
+    r.renderPass(1);
+    L.resize(slots);
+    info.resize(slots);
+    vk::downloadBuffer(test::context(), paths.pathRadiance(), L.data(), slots * 16);
+    vk::downloadBuffer(test::context(), paths.pathInfo(), info.data(), slots * 16);
+  };
+  std::vector<glm::vec4> L0, L1, L2;
+  std::vector<glm::uvec4> info0, info1, info2;
+  trace(u, L0, info0);
+
+  std::vector<glm::vec2> beyond = u, lastRead = u;
+  int shortPaths = 0, lit = 0;
+  for (std::uint32_t i = 0; i < slots; ++i) {
+    const std::uint32_t extent = shared::mltExtent(info0[i].z, dims);
+    shortPaths += extent < dims;
+    for (std::uint32_t d = extent; d < dims; ++d) beyond[shared::primarySampleIndex(i, d, dims)] = fresh();
+    if (info0[i].z > 0) {
+      lastRead[shared::primarySampleIndex(i, shared::rngDimension(info0[i].z - 1, RNG_DIM_LIGHT_POINT), dims)] = fresh();
+      lit += L0[i] != glm::vec4(0.0f);
+    }
+  }
+  trace(beyond, L1, info1);
+  int changed = 0;
+  for (std::uint32_t i = 0; i < slots; ++i) changed += std::memcmp(&L0[i], &L1[i], 12) != 0 || info0[i].z != info1[i].z;
+  EXPECT_EQ(changed, 0) << "a draw beyond a path's recorded extent changed the path";
+  // Not void: many paths end before the last bounce (roulette), so draws beyond them were replaced.
+  EXPECT_GE(shortPaths, int(slots) / 4);
+
+  trace(lastRead, L2, info2);
+  int changedLast = 0;
+  for (std::uint32_t i = 0; i < slots; ++i) changedLast += std::memcmp(&L0[i], &L2[i], 12) != 0;
+  // The last vertex's light sample moves with its point: most lit paths change (a point that stays
+  // unoccluded with the same contribution, or both occluded, is rare on the Cornell box's light).
+  EXPECT_GE(changedLast, lit / 2) << "the last shaded bounce's light-point draw seems unread";
+  std::printf("%d of %u paths end before depth %u; replacing the draws beyond their extent changed %d; "
+              "replacing the last bounce's light point changed %d of %d lit paths\n",
+              shortPaths, slots, s.maxDepth, changed, changedLast, lit);
   EXPECT_EQ(test::validationMessages(), 0u);
 }
