@@ -4,6 +4,7 @@
 #include <csignal>
 #include <cstdio>
 
+#include "render/mlt_integrator.h"
 #include "util/error.h"
 #include "util/progress.h"
 #include "util/stop_signal.h"
@@ -25,8 +26,9 @@ RenderLoop::RenderLoop(Renderer& renderer, RenderRecord base, const RenderRecord
   m_base.settings.traversal = m_renderer.settings().traversal;
   if (m_options.progress) {
     const RenderSettings& s = m_renderer.settings();
-    m_progress = std::make_unique<Progress>("render", m_options.spp, std::uint64_t(s.width) * s.height, false,
-                                            m_options.quiet);
+    // Paths per spp: one per pixel, or one mutation per chain for Metropolis (docs/mlt.md).
+    const std::uint64_t paths = m_renderer.mlt() ? m_renderer.mlt()->report().chains : std::uint64_t(s.width) * s.height;
+    m_progress = std::make_unique<Progress>("render", m_options.spp, paths, false, m_options.quiet);
     m_progress->update(m_renderer.samplesDone());
   }
 }

@@ -6,7 +6,8 @@
 // Not a terminal (a log file, CI): nothing while running, so logs stay readable; finish() prints
 // one summary line either way:
 //   render: 100 spp in 3.2 s (31.2 spp/s, 8.1 Msamples/s)
-// "spp/s" is samples-per-pixel passes per second; "Msamples/s" is pixel samples per second
+// "spp/s" is samples-per-pixel passes per second; "Msamples/s" is paths per second (pixel samples;
+// a Metropolis render: mutations)
 // (passes/s * unitsPerStep), shown when unitsPerStep > 0. Not thread-safe: call from one thread.
 #pragma once
 #include <chrono>
@@ -22,7 +23,8 @@ std::string formatDuration(double seconds);
 class Progress {
  public:
   // label: first word of the bar and of the summary ("render"). total: number of steps (spp).
-  // unitsPerStep: pixels per pass, for Msamples/s (0: not shown). quiet: print nothing at all.
+  // unitsPerStep: paths per step (pixels; chains for Metropolis), for Msamples/s (0: not shown).
+  // quiet: print nothing at all.
   Progress(std::string label, uint64_t total, uint64_t unitsPerStep, bool forceTerminal = false,
            bool quiet = false);
   // Clears an unfinished bar's line, so an error message after an aborted render starts on a
