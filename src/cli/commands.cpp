@@ -877,6 +877,7 @@ int runCli(int argc, char** argv) {
   registerSamplerCommands(app, *bench, run);
   registerPreviewCommand(app, run);
   registerModelsCommand(app, run);
+  registerGuideViewCommand(app, run);
 
   try {
     app.parse(argc, argv);

@@ -22,5 +22,7 @@ void registerBenchError(CLI::App& bench, CommandRunner& run);
 void registerPreviewCommand(CLI::App& app, CommandRunner& run);
 // `nusselt models` (src/cli/models_command.cpp).
 void registerModelsCommand(CLI::App& app, CommandRunner& run);
+// `nusselt guide-view` (src/cli/guide_view.cpp).
+void registerGuideViewCommand(CLI::App& app, CommandRunner& run);
 
 }  // namespace nusselt
