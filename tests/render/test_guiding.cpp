@@ -1,10 +1,13 @@
 // Path guiding (issue 16, docs/guiding.md) in whole renders: the guided estimator is unbiased (its
 // image equals the unguided one within their variances: per-block z-tests with a binomial bound,
 // and a z-test on the difference of the image means), it is deterministic, and it learned
-// something (the test would otherwise compare BSDF sampling with itself).
+// something (the test would otherwise compare BSDF sampling with itself); the selection
+// probability learned per region (the default, --guide-alpha auto) falls back to BRDF sampling in
+// a furnace (its learning where the guide wins: tests/unit/test_guiding.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "../support/test_support.h"
@@ -97,5 +100,73 @@ TEST(Guiding, SameSeedIsBitIdentical) {
   s.guiding = false;
   test::Rendered c = test::render(scene, s);
   EXPECT_NE(0, std::memcmp(a.image.rgb.data(), c.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// ---- The selection probability learned per region (guide_tree.h, learnAlphas) ----------------------
+namespace {
+
+// The regions of a trained guide that learned an alpha (a trained tree and a learning step behind
+// their alpha), and how many of them sample the guide (alpha > 0); `keep` selects regions by box.
+struct AlphaCount {
+  std::uint32_t learned = 0, guided = 0;
+  double alphaSum = 0;
+};
+template <class Keep>
+AlphaCount countLearnedAlphas(const guiding::GuideTree& t, Keep keep) {
+  AlphaCount c;
+  for (std::uint32_t l = 0; l < t.leafCount(); ++l) {
+    glm::vec3 lo, hi;
+    t.leafBounds(l, lo, hi);
+    if (!keep(lo, hi) || !(t.samplingTree(l).total() > 0) || !(t.leafAlphaVertices(l) > 0)) continue;
+    ++c.learned;
+    if (t.leafAlpha(l) > 0) {
+      ++c.guided;
+      c.alphaSum += t.leafAlpha(l);
+    }
+  }
+  return c;
+}
+
+// The smallest k with P(X > k) <= p for X ~ Binomial(n, q).
+std::uint32_t binomialUpper(std::uint32_t n, double q, double p) {
+  return static_cast<std::uint32_t>(test::binomialUpperLimit(static_cast<int>(n), q, p));
+}
+
+// A region whose guide gains nothing takes alpha > 0 only by a false positive of the z-test of
+// learnAlphas: at most (candidates - 1) x its significance (Bonferroni over the candidates).
+double falsePositiveBound(const guiding::GuideSettings& gs) {
+  return double(guiding::kAlphaCandidates.size() - 1) * test::normalPValue(gs.alphaZ) / 2.0;
+}
+
+guiding::GuideSettings defaultGuideSettings() { return guiding::GuideSettings{}; }
+
+}  // namespace
+
+// The white furnace (a closed Lambert sphere, emission 1, rho 0.5): from a point on a sphere,
+// light sampling by area has the cosine density, so NEE's MIS weight is 1/2 in every direction,
+// and the BSDF sampler's estimate f cos L_i / p_bsdf has the same distribution in every direction:
+// no guide can lower its variance, every alpha > 0 raises it. So no region should learn alpha > 0
+// but by a false positive of the z-test (rate q <= falsePositiveBound): the guided regions are at
+// most the 0.999 quantile of Binomial(regions, q). Small regions (c = 300) give many tests.
+TEST(Guiding, LearnedAlphaFallsBackToBsdfSamplingInAFurnace) {
+  Scene scene = test::loadTestScene("scenes/tests/furnace.gltf");
+  RenderSettings s;
+  s.width = s.height = 32;
+  s.spp = 64;
+  s.maxDepth = 8;
+  s.seed = 5;
+  s.guiding = true;
+  s.guideSpatialThreshold = 300;
+  Renderer r(test::context(), scene, s);
+  r.render(s.spp);
+  ASSERT_NE(r.guide(), nullptr);
+  const AlphaCount c = countLearnedAlphas(r.guide()->tree(), [](glm::vec3, glm::vec3) { return true; });
+  const double q = falsePositiveBound(defaultGuideSettings());
+  const std::uint32_t bound = binomialUpper(c.learned, q, 0.001);
+  std::printf("furnace: %u regions learned an alpha, %u sample the guide (bound %u, q = %.4f)\n", c.learned,
+              c.guided, bound, q);
+  EXPECT_GE(c.learned, 10u) << "too few regions learned an alpha for the test to mean anything";
+  EXPECT_LE(c.guided, bound) << "regions that sample the guide in a furnace, of " << c.learned;
   EXPECT_EQ(test::validationMessages(), 0u);
 }
