@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <string>
 
 #include "../support/test_support.h"
 #include "render/environment.h"
@@ -32,8 +33,10 @@ double meanDifferenceZ(const Image& a, const Image& b) {
   return (ma / n - mb / n) / std::sqrt((va + vb) / (n * n));
 }
 
-// A guided and an unguided render of `scene` (different seeds: independent estimates) agree.
-void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, std::uint32_t depth, int block) {
+// A guided and an unguided render of `scene` (different seeds: independent estimates) agree;
+// alpha: the guided render's --guide-alpha (< 0: auto, learned per region).
+void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, std::uint32_t depth, int block,
+                    float alpha = -1.0f) {
   RenderSettings s;
   s.width = s.height = size;
   s.spp = spp;
@@ -42,12 +45,17 @@ void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, s
   test::Rendered plain = test::render(scene, s);
   s.seed = 22;
   s.guiding = true;
+  s.guideAlpha = alpha;
   Renderer r(test::context(), scene, s);
   r.render(s.spp);
   Image guided = r.image(true);
   ASSERT_NE(r.guide(), nullptr);
   ASSERT_FALSE(r.guide()->reports().empty());
   EXPECT_GT(r.guide()->reports().back().dirNodes, 1u) << "the guide must have learned a distribution";
+  if (alpha > 0) EXPECT_GT(r.guide()->reports().back().guidedLeaves, 0u) << "the guide must be sampled";
+  std::printf("alpha %s: the guide sampled in %u of %u regions (mean alpha %.3f)\n",
+              alpha < 0 ? "auto" : std::to_string(alpha).c_str(), r.guide()->reports().back().guidedLeaves,
+              r.guide()->reports().back().leaves, r.guide()->reports().back().meanAlpha);
   EXPECT_EQ(r.stats().nonFiniteSamples, 0u);
   // Per block of block x block pixels: significance 0.01 per block, 0.001 for the binomial bound.
   std::string msg = test::compareImagesStatistically(guided, plain.image, 0.01, 0.001, block);
@@ -64,8 +72,11 @@ void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, s
 }  // namespace
 
 // The Cornell box lit only indirectly (its light faces the ceiling): guiding's home ground.
+// With the learned alpha (the default) and with a fixed one (every region that learned something
+// samples the guide: the mixture itself is tested even where auto falls back everywhere).
 TEST(Guiding, UnbiasedOnIndirectlyLitCornellBox) {
   expectUnbiased(test::loadTestScene("scenes/cornell/cornell-indirect.glb"), 32, 64, 6, 4);
+  expectUnbiased(test::loadTestScene("scenes/cornell/cornell-indirect.glb"), 32, 64, 6, 4, 0.5f);
 }
 
 // Combined materials (not guided, they train), mirror and dielectric components (never guided).
@@ -91,15 +102,21 @@ TEST(Guiding, SameSeedIsBitIdentical) {
   s.maxDepth = 5;
   s.seed = 3;
   s.guiding = true;
-  test::Rendered a = test::render(scene, s);
-  test::Rendered b = test::render(scene, s);
-  ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
-  EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
-  EXPECT_EQ(a.stats.rays, b.stats.rays);
-  // And guiding changed the samples (the same seed unguided gives another image).
-  s.guiding = false;
-  test::Rendered c = test::render(scene, s);
-  EXPECT_NE(0, std::memcmp(a.image.rgb.data(), c.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
+  // The learned alpha (auto, the default) and a fixed one.
+  for (float alpha : {-1.0f, 0.5f}) {
+    s.guideAlpha = alpha;
+    test::Rendered a = test::render(scene, s);
+    test::Rendered b = test::render(scene, s);
+    ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
+    EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float))) << alpha;
+    EXPECT_EQ(a.stats.rays, b.stats.rays);
+    if (alpha < 0) continue;
+    // And guiding changed the samples (the same seed unguided gives another image).
+    s.guiding = false;
+    test::Rendered c = test::render(scene, s);
+    s.guiding = true;
+    EXPECT_NE(0, std::memcmp(a.image.rgb.data(), c.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
+  }
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "guiding/guide_tree.h"
@@ -375,6 +376,8 @@ TEST(Guiding, LearnedAlphaPrefersAGoodGuideAndFallsBackWhereBsdfSamplingIsExact)
   // and below BRDF sampling's.
   Learned a = learnedAlpha(&radiance, 100000);
   const double best = *std::min_element(a.moment.begin(), a.moment.end());
+  std::printf("learned alpha %.2f: second moment %.4g (alpha 0: %.4g, best candidate: %.4g)\n", a.alpha,
+              a.moment[candidateIndex(a.alpha)], a.moment[0], best);
   EXPECT_GT(a.alpha, 0.0f);
   EXPECT_LE(a.moment[candidateIndex(a.alpha)], 1.1 * best) << "alpha " << a.alpha;
   EXPECT_LT(best, a.moment[0]);
