@@ -178,6 +178,9 @@ GuideVertex guideVertex(vec3 x) {
   return v;
 }
 
+// The guide's density per steradian at the world direction w in region v (0 where it has no mass).
+float guideDensity(GuideVertex v, vec3 w) { return guideDirPdf(g.guide.v[0], v.root, w); }
+
 // The mixture's density for the world direction w whose BRDF-sampler density is pdfBsdf.
 float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) {
   if (!(v.alpha > 0.0f)) return pdfBsdf;
@@ -197,6 +200,9 @@ bool guideSampleLocal(GuideVertex v, float uDescent, PathKey k, uint bounce, vec
   return wiLocal.z > 0.0f;
 }
 
+// Whether this pass writes training records (the guide's info.x).
+bool guideRecording() { return g.guide.v[0].info.x > 0u; }
+
 // Training record k = bounce of this path (guiding_layout.h): its ray arrived at x with the path
 // radiance as it stands (call before the stage adds anything); the path ends here unless
 // guideRecordSample follows.
@@ -204,32 +210,36 @@ void guideRecordArrival(uint path, uint bounce, vec3 x) {
   uint n = g.guide.v[0].info.x;
   if (bounce >= n) return;
   GuideRecords R = g.guide.v[0].records;
-  uint i = (path * n + bounce) * 2u;
+  uint i = (path * n + bounce) * GUIDE_RECORD_VEC4S;
   R.v[i] = vec4(x, luminance(g.pathRadiance.v[path].xyz));
   R.v[i + 1u] = vec4(0.0f);
 }
 
 // The path goes on from vertex `bounce` in the world direction wi; value = luminance of the new
-// throughput x the sample's density per steradian, or -1 (a delta sample: not splatted). The next
-// record's arrival is reset to -1 (nothing arrived) until a stage writes it.
-void guideRecordSample(uint path, uint bounce, vec3 wi, float value) {
+// throughput x the sample's density per steradian, or -1 (a delta sample: not splatted);
+// selection = (guide density, BRDF-sampler density, alpha) of the sample (guiding_layout.h, c).
+// The next record's arrival is reset to -1 (nothing arrived) until a stage writes it.
+void guideRecordSample(uint path, uint bounce, vec3 wi, float value, vec3 selection) {
   uint n = g.guide.v[0].info.x;
   if (bounce >= n) return;
   GuideRecords R = g.guide.v[0].records;
-  uint i = (path * n + bounce) * 2u;
+  uint i = (path * n + bounce) * GUIDE_RECORD_VEC4S;
   R.v[i + 1u] = vec4(wi, value > 0.0f ? value : -1.0f);  // 0 would read as "ended here"
-  if (bounce + 1u < n) R.v[i + 2u].w = -1.0f;
+  R.v[i + 2u] = vec4(selection, 0.0f);
+  if (bounce + 1u < n) R.v[i + GUIDE_RECORD_VEC4S].w = -1.0f;
 }
 #else
 // A module without guiding (NUSSELT_SCENE_FEATURES 0, stage_common.glsl): empty stand-ins.
 GuideVertex guideVertex(vec3 x) { return GuideVertex(0u, 0.0f); }
+float guideDensity(GuideVertex v, vec3 w) { return 0.0f; }
 float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) { return pdfBsdf; }
 bool guideSampleLocal(GuideVertex v, float uDescent, PathKey k, uint bounce, vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
   wiLocal = vec3(0.0f, 0.0f, 1.0f);
   return false;
 }
+bool guideRecording() { return false; }
 void guideRecordArrival(uint path, uint bounce, vec3 x) {}
-void guideRecordSample(uint path, uint bounce, vec3 wi, float value) {}
+void guideRecordSample(uint path, uint bounce, vec3 wi, float value, vec3 selection) {}
 #endif
 #endif
 

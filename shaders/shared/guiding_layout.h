@@ -54,16 +54,23 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer GuideRecord
 #endif
 
 // Training records (written by the shade and escape stages while info.x > 0): per path
-// info.x records of two vec4s, record k of path p at (p * info.x + k) * 2:
+// info.x records of GUIDE_RECORD_VEC4S vec4s, record k of path p at (p * info.x + k) *
+// GUIDE_RECORD_VEC4S:
 //   a = (position of vertex k (xyz), luminance of the path's radiance when its ray arrived at
 //        vertex k, before anything vertex k adds; -1: the ray left the scene without an
 //        environment, so nothing arrived);
 //   b = (sampled direction (world, unit), luminance of the throughput after the sample x the
 //        density of the sample per steradian; 0: the path ended at vertex k; -1: it went on
-//        from a vertex whose sample is not splatted (a delta lobe)).
+//        from a vertex whose sample is not splatted (a delta lobe));
+//   c = (the guide's density per steradian at the sampled direction (-1: the vertex does not
+//        sample the mixture, a combined material), the BRDF sampler's density there, the
+//        selection probability alpha the sample was drawn with, 0); read only when b.w > 0.
 // The radiance that reached vertex k from its sampled direction is then (path radiance at the
 // end - a.w of record k + 1) / (luminance of the throughput), and the splat is that divided by
-// the density (src/guiding/guide_tree.cpp, splatPath).
+// the density (src/guiding/guide_tree.cpp, splatPaths); c lets the trainer estimate, per region,
+// the second moment the vertex's estimate would have under another alpha (GuideTree,
+// observeSelection).
+#define GUIDE_RECORD_VEC4S 3u
 // boundsMin, boundsMax: the spatial tree's root box (w unused);
 // info = (records per path, 0: not recording; 0, 0, 0).
 struct GpuGuide {

@@ -134,13 +134,16 @@ float transmissionAt(uint material, uint tri, float b1, float b2) { return -1.0f
 // One step of the walk as the material's sampler drew it: the local direction, the factor the
 // throughput is multiplied by (weight, divided by the choice and albedo-roulette probabilities),
 // the density for MIS at the next hit and for the guide's record, the eta scale of a transmission,
-// and whether the sample was a delta lobe's.
+// whether the sample was a delta lobe's, and for the guide's training record the sample's
+// (guide density, BRDF-sampler density, alpha) (guiding_layout.h, record c; x = -1: the vertex
+// does not sample the guide's mixture).
 struct PathStep {
   vec3 wiLocal;
   vec3 factor;
   float pdf;
   float etaScale;
   bool delta;
+  vec3 selection;
 };
 
 // ---- The material at a hit: one interface, two implementations ----
@@ -184,6 +187,7 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
   s.pdf = 0.0f;
   s.etaScale = 1.0f;
   s.delta = modelIsDelta(MODEL_ID);
+  s.selection = vec3(-1.0f, 0.0f, 0.0f);
   uint dimB = rngDimension(bounce, RNG_DIM_BSDF);
   vec2 uB = pathSample2(k, dimB);
   vec3 wiLocal;
@@ -200,14 +204,21 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
     q = 1.0f;
   } else if (!bsdfSample(SAMPLER, MODEL_ID, m.M.info.z, m.M.params, wo, inside, uB, wiLocal, weight, pdf, q))
     return false;
-  if (GUIDING && m.gv.alpha > 0.0f) {
-    // The mixture's density, for the weight f cos / pdf and for MIS at the next hit.
+  // Training records need both densities wherever the guide could be chosen, also where alpha is
+  // 0 (the trainer estimates from them what another alpha would do: GuideTree::observeSelection).
+  bool record = GUIDING && !modelIsDelta(MODEL_ID) && guideRecording();
+  if (GUIDING && (m.gv.alpha > 0.0f || record)) {
     float pdfB = guided ? bsdfPdf(SAMPLER, MODEL_ID, m.M.info.z, m.M.params, wo, wiLocal) : pdf;
-    float pdfMix = guideMixture(m.gv, toWorld(wiLocal, tt, bb, ns), pdfB);
-    if (!(pdfMix > 0.0f)) return false;
-    weight *= pdf / pdfMix;
-    if (guided) q = min(1.0f, luminance(weight));
-    pdf = pdfMix;
+    float pdfG = guideDensity(m.gv, toWorld(wiLocal, tt, bb, ns));
+    s.selection = vec3(pdfG, pdfB, m.gv.alpha);
+    if (m.gv.alpha > 0.0f) {
+      // The mixture's density, for the weight f cos / pdf and for MIS at the next hit.
+      float pdfMix = guideMixturePdf(m.gv.alpha, pdfG, pdfB);
+      if (!(pdfMix > 0.0f)) return false;
+      weight *= pdf / pdfMix;
+      if (guided) q = min(1.0f, luminance(weight));
+      pdf = pdfMix;
+    }
   }
   // The albedo roulette: with the continuation probability of the sample (the source's).
   if (roulette == ROULETTE_ALBEDO) {
@@ -295,6 +306,7 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
   s.pdf = 0.0f;
   s.etaScale = 1.0f;
   s.delta = false;
+  s.selection = vec3(-1.0f, 0.0f, 0.0f);  // combined materials do not sample the guide yet
   float uC = pathSample1(k, rngDimension(bounce, RNG_DIM_COMPONENT));
   uint j;
   float pk;
@@ -391,7 +403,7 @@ void continuePath(PathStep s, uint path, uint bounce, uint roulette, vec3 x, vec
     if (transmitted) etaScale *= s.etaScale;
     if (!throughputRoulette(bounce, beta, etaScale, uR)) return;
   }
-  if (GUIDING) guideRecordSample(path, bounce, wi, s.delta ? -1.0f : luminance(beta) * s.pdf);
+  if (GUIDING) guideRecordSample(path, bounce, wi, s.delta ? -1.0f : luminance(beta) * s.pdf, s.selection);
   g.pathOrigin.v[path] = vec4(xo, 0.0f);
   g.pathDirection.v[path] = vec4(wi, s.pdf);
   g.pathThroughput.v[path] = vec4(beta, etaScale);

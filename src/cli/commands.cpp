@@ -67,7 +67,7 @@ struct RenderArgs {
   std::uint32_t guideTrain = 0;
   double guideMemoryMiB = 16;
   double guideSpatial = 12000;
-  float guideAlpha = 0.5f;
+  std::string guideAlpha = "auto";
   bool variance = false;
   bool validation = false;
   bool quiet = false;
@@ -77,6 +77,17 @@ struct RenderArgs {
   bool sppGiven = false;
   EnvironmentArgs env;
 };
+
+// --guide-alpha: "auto" (learned per region: a negative alpha in the settings) or a number in
+// [0, maxAlpha].
+float parseGuideAlpha(const std::string& text, float maxAlpha) {
+  if (text == "auto") return -1.0f;
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !(v >= 0.0 && v <= maxAlpha))
+    throw Error("--guide-alpha " + text + ": auto or a number in [0, " + std::to_string(maxAlpha).substr(0, 4) + "]");
+  return static_cast<float>(v);
+}
 
 int renderCommand(const RenderArgs& a) {
   if (a.spp == 0) throw Error("--spp 0: at least one sample per pixel is needed");
@@ -116,7 +127,7 @@ int renderCommand(const RenderArgs& a) {
   s.guiding = a.guiding == "on";
   s.guideTrainSpp = a.guideTrain;
   s.guideSpatialThreshold = a.guideSpatial;
-  s.guideAlpha = a.guideAlpha;
+  s.guideAlpha = parseGuideAlpha(a.guideAlpha, 0.99f);
   s.guideMemory = static_cast<std::uint64_t>(a.guideMemoryMiB * 1048576.0);
   // What Metropolis renders do not support (docs/mlt.md): guiding and the variance of a correlated
   // estimate. A resumed one restarts its chains from a new bootstrap (docs/mlt.md, "Resume").
@@ -251,10 +262,10 @@ int renderCommand(const RenderArgs& a) {
     if (const DeviceGuide* guide = renderer.guide(); guide && !a.quiet) {
       for (const guiding::IterationReport& r : guide->reports())
         std::fprintf(stderr, "guiding: iteration %u: %llu splats; %u regions, %llu direction nodes, %.2f MiB of %.2f MiB "
-                             "(rho %g)%s\n",
+                             "(rho %g)%s; the guide sampled in %u regions (mean alpha %.3f)\n",
                      r.iteration, static_cast<unsigned long long>(r.splats), r.leaves,
                      static_cast<unsigned long long>(r.dirNodes), r.bytes / 1048576.0, s.guideMemory / 1048576.0,
-                     r.dirThreshold, r.capped ? ", memory cap reached" : "");
+                     r.dirThreshold, r.capped ? ", memory cap reached" : "", r.guidedLeaves, r.meanAlpha);
       std::fprintf(stderr, "guiding: %u training spp, %.3f s of CPU time reading records, splatting and refining\n",
                    renderer.summary().guideTrainSpp, guide->trainingSeconds());
     }
@@ -397,7 +408,7 @@ struct BenchArgs {
   std::uint32_t repeats = 1;
   std::string guiding = "off";
   std::uint32_t guideTrain = 1;
-  float guideAlpha = 0.5f;
+  std::string guideAlpha = "0.5";
   EnvironmentArgs env;
 };
 
@@ -430,7 +441,7 @@ BenchRun benchRenderOnce(vk::Context& ctx, const Scene& scene, const std::string
   s.traversal = traversal;
   s.guiding = a.guiding == "on";
   s.guideTrainSpp = a.guideTrain;
-  s.guideAlpha = a.guideAlpha;
+  s.guideAlpha = parseGuideAlpha(a.guideAlpha, 1.0f);
   BenchRun run;
   const auto tSetup = std::chrono::steady_clock::now();
   Renderer r(ctx, scene, s);
@@ -795,10 +806,11 @@ int runCli(int argc, char** argv) {
                                                          "sqrt(2^k) training splats in iteration k (Mueller et al.: "
                                                          "12000, for 1280 x 720 images)")
       ->capture_default_str()->check(CLI::Range(1.0, 1e12));
-  render->add_option("--guide-alpha", ra.guideAlpha, "Probability of sampling the guide where it learned something "
-                                                     "(one-sample MIS with the BSDF sampler; below 1 keeps the render "
-                                                     "unbiased where the guide has no mass)")
-      ->capture_default_str()->check(CLI::Range(0.0f, 0.99f));
+  render->add_option("--guide-alpha", ra.guideAlpha, "Probability of sampling the guide (one-sample MIS with the BSDF "
+                                                     "sampler): auto = learned per region during training (0, no "
+                                                     "guide, where it does not lower the variance), or a number in "
+                                                     "[0, 0.99] for every region that learned something")
+      ->capture_default_str();
   render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
   render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
   render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");
@@ -830,9 +842,10 @@ int runCli(int argc, char** argv) {
   benchRender->add_option("--guide-train", ba.guideTrain, "Guided: training spp (1: the warm-up pass only, so that "
                                                           "the timed passes sample a fixed guide)")
       ->capture_default_str()->check(CLI::Range(1u, 1u << 30));
-  benchRender->add_option("--guide-alpha", ba.guideAlpha, "Guided: probability of sampling the guide (0: the guided "
-                                                          "pipelines run but never take the guide's branch)")
-      ->capture_default_str()->check(CLI::Range(0.0f, 1.0f));
+  benchRender->add_option("--guide-alpha", ba.guideAlpha, "Guided: probability of sampling the guide in [0, 1] (0: the "
+                                                          "guided pipelines run but never take the guide's branch), "
+                                                          "or auto (learned per region)")
+      ->capture_default_str();
   benchRender->add_option("--repeats", ba.repeats, "Repeats of every scene and traversal; with more than one, the "
                                                    "medians and ranges are printed")
       ->capture_default_str()->check(CLI::Range(1u, 1000u));

@@ -126,13 +126,75 @@ std::uint32_t GuideTree::findLeaf(glm::vec3 x) const {
   return m_nodes[node].leaf;  // not reached: the builder stays below the bound
 }
 
-void GuideTree::splat(glm::vec3 x, glm::vec3 d, double value) {
-  Leaf& leaf = m_leaves[findLeaf(x)];
+void GuideTree::leafBounds(std::uint32_t leaf, glm::vec3& lo, glm::vec3& hi) const {
+  for (const SpatialNode& n : m_nodes)
+    if (n.axis == GUIDE_SPATIAL_LEAF && n.leaf == leaf) {
+      lo = n.lo;
+      hi = n.hi;
+      return;
+    }
+  lo = hi = glm::vec3(0.0f);
+}
+
+void GuideTree::splatLeaf(std::uint32_t leafIndex, glm::vec3 d, double value) {
+  Leaf& leaf = m_leaves[leafIndex];
   leaf.samples += 1;
   ++m_splats;
   if (value > 0 && std::isfinite(value)) {
     shared::vec2 p = shared::guideDirectionToSquare(shared::vec3(d.x, d.y, d.z));
     leaf.building.splat(glm::vec2(p.x, p.y), value);
+  }
+}
+
+// ---- The selection probability per region ---------------------------------------------------------
+// A vertex's estimate through its sample is y = F / p_mix (F = f cos L_i, drawn with density p_mix
+// = a p_guide + (1 - a) p_bsdf). With alpha_c instead of a, the same estimate's second moment is
+// E_{p_c}[(F / p_c)^2] = E_{p_mix}[y^2 p_mix / p_c]: every candidate's second moment is estimated
+// from the same samples by reweighting (unbiased wherever p_mix > 0 covers F, which the BRDF
+// sampler's share guarantees). observeSelection sums, per candidate, the difference to alpha = 0,
+// d_c = y^2 p_mix (1 / p_bsdf - 1 / p_c), and its square (for the test in learnAlphas).
+
+void GuideTree::observeSelection(std::uint32_t leafIndex, double y, double pdfGuide, double pdfBsdf, double alpha) {
+  SelectionStats& st = m_leaves[leafIndex].selection;
+  const double pMix = alpha * pdfGuide + (1.0 - alpha) * pdfBsdf;
+  if (!(pMix > 0) || !std::isfinite(pMix) || !(pdfGuide >= 0) || !(pdfBsdf >= 0) || !std::isfinite(y)) return;
+  st.vertices += 1;
+  if (!(y > 0)) return;  // nothing came back: 0 under every alpha
+  // The BRDF sampler has density wherever f cos > 0 (bsdf_sampling.h): a contribution without it
+  // is a rounding case (a direction at the horizon) that says nothing about alpha.
+  if (!(pdfBsdf > 0)) return;
+  const double w = y * y * pMix;
+  for (std::size_t c = 1; c < kAlphaCandidates.size(); ++c) {
+    const double a = kAlphaCandidates[c];
+    const double pc = a * pdfGuide + (1.0 - a) * pdfBsdf;  // > 0: pdfBsdf > 0 and a < 1
+    const double d = w * (1.0 / pdfBsdf - 1.0 / pc);
+    st.gain[c] += d;
+    st.gainSq[c] += d * d;
+  }
+}
+
+// At the end of an iteration, for each leaf whose guide had mass (else its samples say nothing
+// about a guide) and that saw at least alphaMinVertices vertices: the candidate with the largest
+// estimated gain (the smallest second moment) is taken when its gain is significant (z-test of the
+// mean of the d_c: mean / standard error > alphaZ), else alpha = 0 (BRDF sampling alone: where the
+// guide does not pay, it is not used). Other leaves keep their alpha.
+void GuideTree::learnAlphas() {
+  for (Leaf& l : m_leaves) {
+    SelectionStats& st = l.selection;
+    if (m_settings.alpha >= 0) {
+      l.alpha = m_settings.alpha;
+    } else if (l.sampling.total() > 0 && st.vertices >= m_settings.alphaMinVertices) {
+      std::size_t best = 1;
+      for (std::size_t c = 2; c < kAlphaCandidates.size(); ++c)
+        if (st.gain[c] > st.gain[best]) best = c;
+      const double n = st.vertices;
+      const double mean = st.gain[best] / n;
+      const double var = std::max(0.0, st.gainSq[best] / n - mean * mean) * n / (n - 1.0);
+      const bool significant = mean > 0 && mean > m_settings.alphaZ * std::sqrt(var / n);
+      l.alpha = significant ? kAlphaCandidates[best] : 0.0f;
+      l.alphaVertices = n;
+    }
+    st = SelectionStats{};
   }
 }
 
@@ -151,6 +213,9 @@ IterationReport GuideTree::endIteration(std::uint32_t iteration) {
   rep.iteration = iteration;
   rep.splats = m_splats;
   m_splats = 0;
+
+  // 0. Each region's alpha, from the vertices of the iteration (sampled with its guide).
+  learnAlphas();
 
   // 1. The iteration's trees become the ones sampled.
   for (Leaf& l : m_leaves) l.sampling = l.building;
@@ -178,7 +243,9 @@ IterationReport GuideTree::endIteration(std::uint32_t iteration) {
     const std::uint32_t first = static_cast<std::uint32_t>(m_nodes.size());
     Leaf half = m_leaves[li];
     half.samples *= 0.5;
+    half.alphaVertices *= 0.5;
     m_leaves[li].samples *= 0.5;
+    m_leaves[li].alphaVertices *= 0.5;
     const std::uint32_t li2 = static_cast<std::uint32_t>(m_leaves.size());
     m_leaves.push_back(half);
     dirNodes += half.sampling.nodeCount();
@@ -218,6 +285,13 @@ IterationReport GuideTree::endIteration(std::uint32_t iteration) {
   for (const Leaf& l : m_leaves) rep.dirNodes += l.sampling.nodeCount();
   rep.bytes = bytes();
   rep.dirThreshold = rho;
+  double alphaSum = 0;
+  for (const Leaf& l : m_leaves)
+    if (l.sampling.total() > 0 && leafGuideAlpha(l) > 0) {
+      ++rep.guidedLeaves;
+      alphaSum += leafGuideAlpha(l);
+    }
+  rep.meanAlpha = rep.guidedLeaves ? alphaSum / rep.guidedLeaves : 0.0;
   return rep;
 }
 
@@ -245,7 +319,7 @@ void GuideTree::flatten(std::vector<shared::GuideSpatialNode>& spatial, std::vec
       continue;
     }
     const DirTree& t = m_leaves[n.leaf].sampling;
-    const float alpha = t.total() > 0 ? m_settings.alpha : 0.0f;
+    const float alpha = t.total() > 0 ? leafGuideAlpha(m_leaves[n.leaf]) : 0.0f;
     spatial[i].info = shared::uvec4(GUIDE_SPATIAL_LEAF, roots[n.leaf], shared::floatBitsToUint(alpha), 0u);
   }
 }
@@ -254,22 +328,26 @@ void GuideTree::flatten(std::vector<shared::GuideSpatialNode>& spatial, std::vec
 
 std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_t recordsPerPath,
                          const glm::vec4* pathRadiance, std::uint32_t paths) {
+  constexpr std::uint32_t R = GUIDE_RECORD_VEC4S;
   std::uint64_t splats = 0;
   if (recordsPerPath < 2) return 0;
   for (std::uint32_t p = 0; p < paths; ++p) {
     const glm::vec4 L = pathRadiance[p];
     const double lEnd = shared::luminance(shared::vec3(L.x, L.y, L.z));
     if (!std::isfinite(lEnd)) continue;  // dropped from the film too
-    const glm::vec4* r = records + std::size_t(p) * recordsPerPath * 2;
+    const glm::vec4* r = records + std::size_t(p) * recordsPerPath * R;
     for (std::uint32_t k = 0; k + 1 < recordsPerPath; ++k) {
-      const glm::vec4 a = r[2 * k], b = r[2 * k + 1];
+      const glm::vec4 a = r[R * k], b = r[R * k + 1], c = r[R * k + 2];
       if (b.w == 0.0f) break;  // the path ended at vertex k
       if (!(b.w > 0.0f)) continue;  // a delta sample: the path goes on, nothing to splat
-      const float arrived = r[2 * (k + 1)].w;
+      const float arrived = r[R * (k + 1)].w;
       // What reached vertex k through its sample: everything the path gathered from vertex k + 1's
       // arrival on; nothing when that ray left a scene without environment (-1).
       const double after = arrived < 0.0f ? 0.0 : std::max(0.0, lEnd - double(arrived));
-      tree.splat(glm::vec3(a), glm::vec3(b), after / double(b.w));
+      const std::uint32_t leaf = tree.findLeaf(glm::vec3(a));
+      tree.splatLeaf(leaf, glm::vec3(b), after / double(b.w));
+      // The same radiance is the vertex's estimate through its sample (y = F / p_mix).
+      if (c.x >= 0.0f) tree.observeSelection(leaf, after, c.x, c.y, c.z);
       ++splats;
     }
   }

@@ -13,6 +13,11 @@
 //      tree's energy is split, down to maxDirDepth), energies zero;
 // within the memory cap (the flat arrays' bytes, spatial and directional): spatial splits stop
 // at the cap, and rho doubles until the refined trees fit.
+// Before step 1, each leaf's selection probability alpha is learned from the iteration's vertices
+// (observeSelection; settings.alpha < 0, the default): the second moment of a vertex's one-sample
+// MIS estimate under each candidate alpha of kAlphaCandidates, estimated from the samples drawn
+// with the alpha the iteration used, and the guide is used (alpha = the best candidate) only
+// where it lowers that moment significantly against alpha = 0 (BRDF sampling alone).
 // Everything runs in a fixed order: the same splats give the same trees, bit for bit.
 #pragma once
 #include <array>
@@ -24,6 +29,14 @@
 #include "../../shaders/shared/guiding.h"
 
 namespace nusselt::guiding {
+
+// GuideSettings::alpha for a selection probability learned per region.
+constexpr float kGuideAlphaAuto = -1.0f;
+// The alphas a region can learn: 0 (BRDF sampling alone: the fallback) and the guide's clamped
+// range [0.05, 0.95] in steps that are finer near the ends (where the second moment changes
+// fastest: as 1 / (1 - alpha) where the guide has no mass, as 1 / alpha where only it has).
+constexpr std::array<float, 13> kAlphaCandidates = {0.0f, 0.05f, 0.1f, 0.15f, 0.2f, 0.3f, 0.4f,
+                                                    0.5f, 0.6f,  0.7f, 0.8f, 0.9f,  0.95f};
 
 struct GuideSettings {
   // c of the spatial split rule (Mueller et al.: 12000): a leaf splits once it received more than
@@ -40,8 +53,13 @@ struct GuideSettings {
   // Bytes of the flat arrays (GuideSpatialNode + GuideDirNode) at most: 16 MiB by default.
   std::uint64_t memoryCap = 16ull << 20;
   // Probability of choosing the guide in a region that has learned something (one-sample MIS
-  // with the BRDF sampler); 0.5 until it is learned per region.
-  float alpha = 0.5f;
+  // with the BRDF sampler): a fixed value in [0, 1), or kGuideAlphaAuto: learned per region.
+  float alpha = kGuideAlphaAuto;
+  // Learned alpha: the vertices a region needs in an iteration to change its alpha, and the z of
+  // the one-sided test that the guide's best alpha lowers the second moment against alpha = 0
+  // (3.09: significance 0.001 per candidate, at most 12 x 0.001 over the candidates).
+  double alphaMinVertices = 64;
+  double alphaZ = 3.09;
 };
 
 // A quadtree over the map [0, 1)^2; node 0 is the root. energy[c] of a node = the energy of
@@ -69,6 +87,16 @@ class DirTree {
   std::vector<Node> m_nodes;
 };
 
+// A region's vertices of one iteration, for its alpha: per candidate c of kAlphaCandidates the sum
+// over the vertices of d_c = y^2 p_mix (1 / p_bsdf - 1 / p_c) and of d_c^2 (y: the vertex's
+// estimate through its sample, p_mix: the density it was drawn with, p_c: the mixture's density
+// at alpha_c), whose mean estimates how much the second moment of y falls when alpha_c replaces
+// BRDF sampling alone.
+struct SelectionStats {
+  std::array<double, kAlphaCandidates.size()> gain{}, gainSq{};
+  double vertices = 0;
+};
+
 struct IterationReport {
   std::uint32_t iteration = 0;
   std::uint64_t splats = 0;         // splats of the iteration
@@ -77,6 +105,8 @@ struct IterationReport {
   std::uint64_t bytes = 0;          // flat arrays' bytes (what the cap bounds)
   double dirThreshold = 0;          // rho used (raised above the setting when the cap bit)
   bool capped = false;              // the memory cap stopped a split or raised rho
+  std::uint32_t guidedLeaves = 0;   // regions sampling the guide (alpha > 0 and a trained tree)
+  double meanAlpha = 0;             // their mean alpha
 };
 
 class GuideTree {
@@ -86,12 +116,17 @@ class GuideTree {
 
   // One splat: value (>= 0) = the radiance estimate arriving at x from direction d divided by the
   // density per steradian with which d was sampled; counts one sample of x's leaf.
-  void splat(glm::vec3 x, glm::vec3 d, double value);
+  void splat(glm::vec3 x, glm::vec3 d, double value) { splatLeaf(findLeaf(x), d, value); }
+  void splatLeaf(std::uint32_t leaf, glm::vec3 d, double value);
+  // A vertex of leaf `leaf` sampled by the mixture: y = its estimate through the sample (the
+  // radiance it carried, >= 0), pdfGuide and pdfBsdf = the guide's and the BRDF sampler's
+  // densities at the sampled direction, alpha = the selection probability it was drawn with.
+  void observeSelection(std::uint32_t leaf, double y, double pdfGuide, double pdfBsdf, double alpha);
   // The end of training iteration `iteration` (0, 1, ...): build, refine, report.
   IterationReport endIteration(std::uint32_t iteration);
 
-  // The flat arrays of the sampling trees (guiding_layout.h); leaf alpha = settings.alpha where
-  // the tree has energy, 0 elsewhere.
+  // The flat arrays of the sampling trees (guiding_layout.h); leaf alpha = the leaf's alpha
+  // (settings.alpha when fixed) where the tree has energy, 0 elsewhere.
   void flatten(std::vector<shared::GuideSpatialNode>& spatial, std::vector<shared::GuideDirNode>& dir) const;
   // Bytes of the flat arrays.
   std::uint64_t bytes() const;
@@ -101,6 +136,13 @@ class GuideTree {
   const DirTree& samplingTree(std::uint32_t leaf) const { return m_leaves[leaf].sampling; }
   const DirTree& buildingTree(std::uint32_t leaf) const { return m_leaves[leaf].building; }
   double leafSamples(std::uint32_t leaf) const { return m_leaves[leaf].samples; }
+  // The leaf's selection probability (before the tree check of flatten), and the vertices its
+  // last learning step saw (0: never learned; a split leaf's halves get half each).
+  float leafAlpha(std::uint32_t leaf) const { return m_leaves[leaf].alpha; }
+  double leafAlphaVertices(std::uint32_t leaf) const { return m_leaves[leaf].alphaVertices; }
+  const SelectionStats& leafSelection(std::uint32_t leaf) const { return m_leaves[leaf].selection; }
+  // The leaf's box.
+  void leafBounds(std::uint32_t leaf, glm::vec3& lo, glm::vec3& hi) const;
   glm::vec3 boundsMin() const { return m_lo; }
   glm::vec3 boundsMax() const { return m_hi; }
   const GuideSettings& settings() const { return m_settings; }
@@ -116,7 +158,12 @@ class GuideTree {
   struct Leaf {
     DirTree sampling, building;
     double samples = 0;
+    float alpha = 0;  // learned: 0 until the region's guide proves itself
+    double alphaVertices = 0;
+    SelectionStats selection;
   };
+  void learnAlphas();
+  float leafGuideAlpha(const Leaf& l) const { return m_settings.alpha >= 0 ? m_settings.alpha : l.alpha; }
   std::uint64_t bytesOf(std::size_t spatialNodes, std::uint64_t dirNodes) const;
 
   GuideSettings m_settings;
@@ -126,9 +173,9 @@ class GuideTree {
   std::uint64_t m_splats = 0;
 };
 
-// Splats the training records of `paths` paths (guiding_layout.h: recordsPerPath records of two
-// vec4 per path) with their final radiance (pathRadiance, rgb) into the tree, paths in order.
-// Returns the number of splats.
+// Splats the training records of `paths` paths (guiding_layout.h: recordsPerPath records of
+// GUIDE_RECORD_VEC4S vec4 per path) with their final radiance (pathRadiance, rgb) into the tree,
+// paths in order, and gives each mixture vertex to observeSelection. Returns the number of splats.
 std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_t recordsPerPath,
                          const glm::vec4* pathRadiance, std::uint32_t paths);
 

@@ -18,6 +18,7 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
 // The directional nodes start at this byte offset of the arrays buffer, after at most this many
 // spatial nodes' bytes: the spatial array never exceeds the cap either, so both fit in cap + 32.
 std::uint64_t arraysBytes(std::uint64_t cap) { return cap + sizeof(shared::GuideDirNode); }
+constexpr std::uint64_t kRecordBytes = GUIDE_RECORD_VEC4S * sizeof(glm::vec4);
 }  // namespace
 
 std::uint32_t DeviceGuide::recordsPerPath(std::uint32_t maxDepth) {
@@ -25,7 +26,7 @@ std::uint32_t DeviceGuide::recordsPerPath(std::uint32_t maxDepth) {
 }
 
 std::uint64_t DeviceGuide::bytesFor(std::uint64_t memoryCap, std::uint32_t pathCapacity, std::uint32_t maxDepth) {
-  return sizeof(GpuGuide) + arraysBytes(memoryCap) + std::uint64_t(pathCapacity) * recordsPerPath(maxDepth) * 32;
+  return sizeof(GpuGuide) + arraysBytes(memoryCap) + std::uint64_t(pathCapacity) * recordsPerPath(maxDepth) * kRecordBytes;
 }
 
 DeviceGuide::DeviceGuide(vk::Context& ctx, glm::vec3 lo, glm::vec3 hi, const guiding::GuideSettings& settings,
@@ -33,7 +34,7 @@ DeviceGuide::DeviceGuide(vk::Context& ctx, glm::vec3 lo, glm::vec3 hi, const gui
     : m_ctx(ctx), m_tree(lo, hi, settings), m_recordsPerPath(recordsPerPath(maxDepth)), m_capacity(pathCapacity) {
   m_info = vk::createBuffer(m_ctx, sizeof(GpuGuide), 0, true, "path guide");
   m_arrays = vk::createBuffer(m_ctx, arraysBytes(settings.memoryCap), 0, true, "path guide trees");
-  m_records = vk::createBuffer(m_ctx, std::uint64_t(pathCapacity) * m_recordsPerPath * 32, 0, false,
+  m_records = vk::createBuffer(m_ctx, std::uint64_t(pathCapacity) * m_recordsPerPath * kRecordBytes, 0, false,
                                "path guide training records");
   upload();
 }
@@ -81,7 +82,7 @@ void DeviceGuide::setRecording(bool on) {
 void DeviceGuide::consumeChunk(const vk::Buffer& pathRadiance, std::uint32_t paths) {
   if (!m_recording || paths == 0) return;
   const auto t0 = std::chrono::steady_clock::now();
-  m_hostRecords.resize(std::size_t(paths) * m_recordsPerPath * 2);
+  m_hostRecords.resize(std::size_t(paths) * m_recordsPerPath * GUIDE_RECORD_VEC4S);
   m_hostRadiance.resize(paths);
   vk::downloadBuffer(m_ctx, m_records, m_hostRecords.data(), m_hostRecords.size() * sizeof(glm::vec4));
   vk::downloadBuffer(m_ctx, pathRadiance, m_hostRadiance.data(), m_hostRadiance.size() * sizeof(glm::vec4));

@@ -60,7 +60,7 @@ class DeviceGuide {
   bool m_recording = false;
   vk::Buffer m_info;     // one GpuGuide (host visible)
   vk::Buffer m_arrays;   // spatial nodes then directional nodes (the cap's bytes)
-  vk::Buffer m_records;  // capacity x recordsPerPath x 2 vec4
+  vk::Buffer m_records;  // capacity x recordsPerPath x GUIDE_RECORD_VEC4S vec4
   std::vector<glm::vec4> m_hostRecords, m_hostRadiance;
   std::vector<guiding::IterationReport> m_reports;
   double m_seconds = 0;

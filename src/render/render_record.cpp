@@ -104,7 +104,11 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
   if (r.settings.guiding) {
     meta.strings.push_back({"nusselt/guiding", "on"});
     meta.ints.push_back({"nusselt/guideTrainSpp", guideTrainingSpp(r.settings)});
-    meta.doubles.push_back({"nusselt/guideAlpha", r.settings.guideAlpha});
+    // The selection probability: "auto" (learned per region) as a string, a fixed one as before.
+    if (r.settings.guideAlpha < 0)
+      meta.strings.push_back({"nusselt/guideAlpha", "auto"});
+    else
+      meta.doubles.push_back({"nusselt/guideAlpha", r.settings.guideAlpha});
     meta.doubles.push_back({"nusselt/guideSpatial", r.settings.guideSpatialThreshold});
     meta.doubles.push_back({"nusselt/guideMemory", double(r.settings.guideMemory)});
   }
@@ -214,7 +218,10 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   // Absent in unguided renders (and files written before guiding existed).
   r.settings.guiding = findString(meta, "nusselt/guiding").value_or("off") == "on";
   r.settings.guideTrainSpp = static_cast<std::uint32_t>(findInt(meta, "nusselt/guideTrainSpp").value_or(0));
-  r.settings.guideAlpha = static_cast<float>(findDouble(meta, "nusselt/guideAlpha").value_or(0.5));
+  // Files written before "auto" existed used a fixed alpha (0.5 by default).
+  r.settings.guideAlpha = findString(meta, "nusselt/guideAlpha").value_or("") == "auto"
+                              ? -1.0f
+                              : static_cast<float>(findDouble(meta, "nusselt/guideAlpha").value_or(0.5));
   r.settings.guideSpatialThreshold = findDouble(meta, "nusselt/guideSpatial").value_or(12000);
   r.settings.guideMemory = static_cast<std::uint64_t>(findDouble(meta, "nusselt/guideMemory").value_or(16 << 20));
   return r;

@@ -156,9 +156,11 @@ struct RenderSettings {
   std::uint32_t guideTrainSpp = 0;
   // The guide's trees at most this many bytes on the device (`--guide-memory`, MiB there).
   std::uint64_t guideMemory = 16ull << 20;
-  // The guide's selection probability in regions that learned something (`--guide-alpha`): 0
-  // keeps the guided pipelines but never samples the guide (to measure their cost).
-  float guideAlpha = 0.5f;
+  // The guide's selection probability (`--guide-alpha`): < 0 (`auto`, the default) learns it per
+  // region (guiding::kGuideAlphaAuto; docs/guiding.md); a value in [0, 1) serves every region
+  // that learned something (0 keeps the guided pipelines but never samples the guide, to measure
+  // their cost).
+  float guideAlpha = -1.0f;
   // c of the guide's spatial split rule (`--guide-spatial`): a region splits after c sqrt(2^k)
   // splats in iteration k. Mueller et al.'s 12000 suits their 1280 x 720 images; small images
   // get few regions with it (docs/guiding.md, measurements).

@@ -1,11 +1,15 @@
 // Path guiding (issue 16, docs/guiding.md) in whole renders: the guided estimator is unbiased (its
 // image equals the unguided one within their variances: per-block z-tests with a binomial bound,
 // and a z-test on the difference of the image means), it is deterministic, and it learned
-// something (the test would otherwise compare BSDF sampling with itself).
+// something (the test would otherwise compare BSDF sampling with itself); the selection
+// probability learned per region (the default, --guide-alpha auto) falls back to BRDF sampling in
+// a furnace (its learning where the guide wins: tests/unit/test_guiding.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <string>
 
 #include "../support/test_support.h"
 #include "render/environment.h"
@@ -29,8 +33,10 @@ double meanDifferenceZ(const Image& a, const Image& b) {
   return (ma / n - mb / n) / std::sqrt((va + vb) / (n * n));
 }
 
-// A guided and an unguided render of `scene` (different seeds: independent estimates) agree.
-void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, std::uint32_t depth, int block) {
+// A guided and an unguided render of `scene` (different seeds: independent estimates) agree;
+// alpha: the guided render's --guide-alpha (< 0: auto, learned per region).
+void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, std::uint32_t depth, int block,
+                    float alpha = -1.0f) {
   RenderSettings s;
   s.width = s.height = size;
   s.spp = spp;
@@ -39,12 +45,17 @@ void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, s
   test::Rendered plain = test::render(scene, s);
   s.seed = 22;
   s.guiding = true;
+  s.guideAlpha = alpha;
   Renderer r(test::context(), scene, s);
   r.render(s.spp);
   Image guided = r.image(true);
   ASSERT_NE(r.guide(), nullptr);
   ASSERT_FALSE(r.guide()->reports().empty());
   EXPECT_GT(r.guide()->reports().back().dirNodes, 1u) << "the guide must have learned a distribution";
+  if (alpha > 0) EXPECT_GT(r.guide()->reports().back().guidedLeaves, 0u) << "the guide must be sampled";
+  std::printf("alpha %s: the guide sampled in %u of %u regions (mean alpha %.3f)\n",
+              alpha < 0 ? "auto" : std::to_string(alpha).c_str(), r.guide()->reports().back().guidedLeaves,
+              r.guide()->reports().back().leaves, r.guide()->reports().back().meanAlpha);
   EXPECT_EQ(r.stats().nonFiniteSamples, 0u);
   // Per block of block x block pixels: significance 0.01 per block, 0.001 for the binomial bound.
   std::string msg = test::compareImagesStatistically(guided, plain.image, 0.01, 0.001, block);
@@ -61,8 +72,11 @@ void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, s
 }  // namespace
 
 // The Cornell box lit only indirectly (its light faces the ceiling): guiding's home ground.
+// With the learned alpha (the default) and with a fixed one (every region that learned something
+// samples the guide: the mixture itself is tested even where auto falls back everywhere).
 TEST(Guiding, UnbiasedOnIndirectlyLitCornellBox) {
   expectUnbiased(test::loadTestScene("scenes/cornell/cornell-indirect.glb"), 32, 64, 6, 4);
+  expectUnbiased(test::loadTestScene("scenes/cornell/cornell-indirect.glb"), 32, 64, 6, 4, 0.5f);
 }
 
 // Combined materials (not guided, they train), mirror and dielectric components (never guided).
@@ -88,14 +102,88 @@ TEST(Guiding, SameSeedIsBitIdentical) {
   s.maxDepth = 5;
   s.seed = 3;
   s.guiding = true;
-  test::Rendered a = test::render(scene, s);
-  test::Rendered b = test::render(scene, s);
-  ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
-  EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
-  EXPECT_EQ(a.stats.rays, b.stats.rays);
-  // And guiding changed the samples (the same seed unguided gives another image).
-  s.guiding = false;
-  test::Rendered c = test::render(scene, s);
-  EXPECT_NE(0, std::memcmp(a.image.rgb.data(), c.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
+  // The learned alpha (auto, the default) and a fixed one.
+  for (float alpha : {-1.0f, 0.5f}) {
+    s.guideAlpha = alpha;
+    test::Rendered a = test::render(scene, s);
+    test::Rendered b = test::render(scene, s);
+    ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
+    EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float))) << alpha;
+    EXPECT_EQ(a.stats.rays, b.stats.rays);
+    if (alpha < 0) continue;
+    // And guiding changed the samples (the same seed unguided gives another image).
+    s.guiding = false;
+    test::Rendered c = test::render(scene, s);
+    s.guiding = true;
+    EXPECT_NE(0, std::memcmp(a.image.rgb.data(), c.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
+  }
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// ---- The selection probability learned per region (guide_tree.h, learnAlphas) ----------------------
+namespace {
+
+// The regions of a trained guide that learned an alpha (a trained tree and a learning step behind
+// their alpha), and how many of them sample the guide (alpha > 0); `keep` selects regions by box.
+struct AlphaCount {
+  std::uint32_t learned = 0, guided = 0;
+  double alphaSum = 0;
+};
+template <class Keep>
+AlphaCount countLearnedAlphas(const guiding::GuideTree& t, Keep keep) {
+  AlphaCount c;
+  for (std::uint32_t l = 0; l < t.leafCount(); ++l) {
+    glm::vec3 lo, hi;
+    t.leafBounds(l, lo, hi);
+    if (!keep(lo, hi) || !(t.samplingTree(l).total() > 0) || !(t.leafAlphaVertices(l) > 0)) continue;
+    ++c.learned;
+    if (t.leafAlpha(l) > 0) {
+      ++c.guided;
+      c.alphaSum += t.leafAlpha(l);
+    }
+  }
+  return c;
+}
+
+// The smallest k with P(X > k) <= p for X ~ Binomial(n, q).
+std::uint32_t binomialUpper(std::uint32_t n, double q, double p) {
+  return static_cast<std::uint32_t>(test::binomialUpperLimit(static_cast<int>(n), q, p));
+}
+
+// A region whose guide gains nothing takes alpha > 0 only by a false positive of the z-test of
+// learnAlphas: at most (candidates - 1) x its significance (Bonferroni over the candidates).
+double falsePositiveBound(const guiding::GuideSettings& gs) {
+  return double(guiding::kAlphaCandidates.size() - 1) * test::normalPValue(gs.alphaZ) / 2.0;
+}
+
+guiding::GuideSettings defaultGuideSettings() { return guiding::GuideSettings{}; }
+
+}  // namespace
+
+// The white furnace (a closed Lambert sphere, emission 1, rho 0.5): from a point on a sphere,
+// light sampling by area has the cosine density, so NEE's MIS weight is 1/2 in every direction,
+// and the BSDF sampler's estimate f cos L_i / p_bsdf has the same distribution in every direction:
+// no guide can lower its variance, every alpha > 0 raises it. So no region should learn alpha > 0
+// but by a false positive of the z-test (rate q <= falsePositiveBound): the guided regions are at
+// most the 0.999 quantile of Binomial(regions, q). Small regions (c = 300) give many tests.
+TEST(Guiding, LearnedAlphaFallsBackToBsdfSamplingInAFurnace) {
+  Scene scene = test::loadTestScene("scenes/tests/furnace.gltf");
+  RenderSettings s;
+  s.width = s.height = 32;
+  s.spp = 64;
+  s.maxDepth = 8;
+  s.seed = 5;
+  s.guiding = true;
+  s.guideSpatialThreshold = 300;
+  Renderer r(test::context(), scene, s);
+  r.render(s.spp);
+  ASSERT_NE(r.guide(), nullptr);
+  const AlphaCount c = countLearnedAlphas(r.guide()->tree(), [](glm::vec3, glm::vec3) { return true; });
+  const double q = falsePositiveBound(defaultGuideSettings());
+  const std::uint32_t bound = binomialUpper(c.learned, q, 0.001);
+  std::printf("furnace: %u regions learned an alpha, %u sample the guide (bound %u, q = %.4f)\n", c.learned,
+              c.guided, bound, q);
+  EXPECT_GE(c.learned, 10u) << "too few regions learned an alpha for the test to mean anything";
+  EXPECT_LE(c.guided, bound) << "regions that sample the guide in a furnace, of " << c.learned;
   EXPECT_EQ(test::validationMessages(), 0u);
 }
