@@ -242,16 +242,32 @@ TEST(RoughDielectric, ReciprocityAndSides) {
   EXPECT_GT(nonzero, 10000);
 }
 
-// The model's catalogue entry: transmitting, not delta; eval through the dispatch equals the
-// scalar formula; zero in the plane of the surface.
+// The model's catalogue entry: transmitting, not delta, the shaders' modelTransmits equal to the
+// catalogue for every model; the parameters seen from the inside; eval through the dispatch equals
+// the scalar formula; zero in the plane of the surface.
 TEST(RoughDielectric, CatalogueAndDispatch) {
   const ModelSpec* m = findModel("rough_dielectric");
   ASSERT_NE(m, nullptr);
   EXPECT_TRUE(m->transmits);
   EXPECT_FALSE(m->delta);
-  for (const ModelSpec& o : allModels())
+  for (const ModelSpec& o : allModels()) {
     if (o.id != m->id) EXPECT_FALSE(o.transmits) << o.name;
+    // The shaders' trait (dispatch.h) is the catalogue's.
+    EXPECT_EQ(shared::modelTransmits(o.id), o.transmits) << o.name;
+  }
   BrdfParams p = packParams(*m, typicalParams(*m), "rough_dielectric");
+  // Seen from the inside: eta -> 1 / eta, so that f(wi, wo) = f'(flipZ wi, flipZ wo) (the renderer's
+  // turned-over frame); etaScale (n_wi / n_wo)^2 of a crossing from either side.
+  BrdfParams q = shared::transmissionInsideParams(m->id, p);
+  EXPECT_EQ(shared::brdfParam(q, ROUGH_DIELECTRIC_ETA), 1.0f / 1.5f);
+  EXPECT_EQ(shared::brdfParam(q, ROUGH_DIELECTRIC_ALPHA), 0.2f);
+  for (auto [wi, wo] : {std::pair{flipZ(dirAt(20, 180)), dirAt(30)}, std::pair{dirAt(50, 90), dirAt(10)}}) {
+    const float a = shared::brdfEval(m->id, p, wi, wo).x, b = shared::brdfEval(m->id, q, flipZ(wi), flipZ(wo)).x;
+    EXPECT_GT(a, 0.0f);
+    EXPECT_NEAR(a, b, 1e-5f * a);
+  }
+  EXPECT_FLOAT_EQ(shared::transmissionEtaScale(m->id, p, false), 1.5f * 1.5f);
+  EXPECT_FLOAT_EQ(shared::transmissionEtaScale(m->id, q, true), 1.0f / (1.5f * 1.5f));
   vec3 wo = dirAt(30), wi = flipZ(dirAt(20, 180));
   EXPECT_EQ(shared::brdfEval(MODEL_ROUGH_DIELECTRIC, p, wi, wo).x, float(F(0.2f, 1.5f, wi, wo)));
   EXPECT_GT(F(0.2f, 1.5f, wi, wo), 0.0);
