@@ -235,8 +235,10 @@ TEST(EnvironmentRender, FurnaceRoughGlassSphereIsInvisibleAndEta2Inside) {
         var += r.image.variance[3 * i];
       }
       const double mean = sum / n, se = std::sqrt(var) / n, expected = inside ? double(eta) * eta : 1.0;
-      std::printf("[ rough furnace ] alpha %.1f %s camera: %.5f +- %.5f, expected %.5f (lossless; loss_max %.5f)\n",
-                  alpha, inside ? "inside " : "outside", mean, se, expected, lossMax);
+      std::printf("[ rough furnace ] alpha %.1f %s camera: %.5f +- %.5f, expected %.5f (lossless; loss_max %.5f); "
+                  "sampler bound violations %llu, trial failures %llu\n",
+                  alpha, inside ? "inside " : "outside", mean, se, expected, lossMax,
+                  (unsigned long long)r.stats.samplerBoundViolations, (unsigned long long)r.stats.samplerTrialFailures);
       EXPECT_LT(mean, expected + zMax * se) << "alpha " << alpha << " inside " << inside;
       EXPECT_GT(mean, expected * (1 - 4 * lossMax) - zMax * se) << "alpha " << alpha << " inside " << inside;
     }

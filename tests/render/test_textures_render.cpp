@@ -798,9 +798,10 @@ TEST(RoughTransmission, LightBehindARoughInterfaceAgreesUnderNeeBsdfAndMis) {
     const test::Rendered r = test::render(s, rs);
     EXPECT_EQ(r.stats.nonFiniteSamples, 0u);
     const auto [mean, se] = imageMean(r.image);
-    std::printf("[ rough transmission ] %s: image %.5f +- %.5f, expected %.5f (quadrature allowance %.1e), z = %.2f\n",
-                lightingModeName(mode), mean, se, expected, allowance,
-                (std::fabs(mean - expected) - allowance) / se);
+    std::printf("[ rough transmission ] %s: image %.5f +- %.5f, expected %.5f (quadrature allowance %.1e), z = %.2f; "
+                "sampler bound violations %llu, trial failures %llu\n",
+                lightingModeName(mode), mean, se, expected, allowance, (std::fabs(mean - expected) - allowance) / se,
+                (unsigned long long)r.stats.samplerBoundViolations, (unsigned long long)r.stats.samplerTrialFailures);
     EXPECT_LT(std::fabs(mean - expected), zMax * se + allowance) << lightingModeName(mode);
   }
   EXPECT_EQ(test::validationMessages(), 0u);
