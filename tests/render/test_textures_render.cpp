@@ -818,7 +818,7 @@ TEST(RoughTransmission, SmoothLimitTransmitsAsTheSmoothDielectric) {
   const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 2.0)));
   for (bool rough : {true, false}) {
     Scene s = emitterUnderRoughInterface(
-        rough ? roughGlass(0.001, eta) : catalogueMaterial("dielectric", {{"eta", ParamValue::num(eta)}}, "glass"));
+        rough ? roughGlass(double(0.001f), eta) : catalogueMaterial("dielectric", {{"eta", ParamValue::num(eta)}}, "glass"));
     const test::Rendered r = test::render(s, exactSettings(1, rough ? 43 : 44, 64));
     const auto [mean, se] = imageMean(r.image);
     std::printf("[ rough transmission ] %s: image %.6f +- %.6f, (1 - R) / eta^2 = %.6f, z = %.2f\n",
