@@ -827,3 +827,47 @@ TEST(RoughTransmission, SmoothLimitTransmitsAsTheSmoothDielectric) {
   }
   EXPECT_EQ(test::validationMessages(), 0u);
 }
+
+// Beer-Lambert inside a rough volume, and the inside of the object: the absorbing slab of
+// TexturesRender.AbsorbingSlabTransmitsFresnelTimesBeerLambert (sigma = (1, 3, 8) per metre,
+// between z = 0.2 and 0.4), seen straight down, made of rough_dielectric at alpha 0.02: paths
+// inside meet the faces from the back (the inside parameters, eta 1 / 1.5, and their own
+// quadtree set) and are attenuated over their segments. Converges to the smooth slab's
+// (1 - R)^2 tau / (1 - R^2 tau^2) per channel within statistics (z-test of the image mean per
+// channel, significance 0.001 with Sidak over 3). At normal incidence the rough slab differs
+// from the smooth one by O(alpha^2); seen at 60 degrees it does not: inside at 35 degrees, GGX's
+// heavy tail (3 % of the microfacets tilted beyond 6.5 degrees at alpha 0.02) reaches total
+// internal reflection, and the image was 2.5 % below the smooth value. (At alpha 0.001 the
+// standard error was 0.2 at 64 spp: off the sampler's tables the defensive cosine part meets the
+// near-delta lobe rarely and with huge weights; unbiased, but no test.)
+TEST(RoughTransmission, AbsorbingRoughSlabNearTheSmoothLimitTransmitsFresnelTimesBeerLambert) {
+  const double eta = 1.5, d = 0.2;
+  const glm::dvec3 sigma(1.0, 3.0, 8.0);
+  Scene s;
+  Material glass = roughGlass(0.02, eta);
+  glass.absorption = glm::vec3(sigma);
+  s.materials.push_back(glass);
+  s.materials.push_back(catalogueMaterial("lambert", {{"rho", ParamValue::num(0.0)}}, "lamp", glm::vec3(1.0f)));
+  addTexturedQuad(s, 0.4f, 0, 6.0f);
+  addTexturedQuad(s, 0.2f, 0, 6.0f, true);
+  addTexturedQuad(s, 0.0f, 1, 6.0f);
+  lookDown(s, 1.0f, 0.9f);
+  RenderSettings rs = exactSettings(12, 47, 64);
+  const double R = (eta - 1) * (eta - 1) / ((eta + 1) * (eta + 1)), ct = 1.0;
+  glm::dvec3 expected;
+  for (int k = 0; k < 3; ++k) {
+    const double tau = std::exp(-sigma[k] * d / ct);
+    expected[k] = (1 - R) * (1 - R) * tau / (1 - R * R * tau * tau);
+  }
+  const test::Rendered r = test::render(s, rs);
+  for (int k = 0; k < 3; ++k) {
+    double sum = 0, var = 0;
+    for (std::size_t p = 0; p < 256; ++p) {
+      sum += r.image.rgb[3 * p + k];
+      var += r.image.variance[3 * p + k];
+    }
+    std::printf("[ rough transmission ] absorbing rough slab channel %d: %.5f +- %.5f, expected %.5f\n", k, sum / 256,
+                std::sqrt(var) / 256, expected[k]);
+  }
+  expectImageMeanRgb(r, expected);
+}
