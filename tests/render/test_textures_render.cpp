@@ -780,29 +780,35 @@ std::pair<double, double> imageMean(const Image& image) {
 // pdf) and MIS (the quadtree's density below the surface in the power heuristic at both ends)
 // are three unbiased estimators of the same image, which is the transmission towards the lamp by
 // quadrature (8 x 8 footprint points, N = 256; the quadrature's own error is bounded by its
-// change against 4 x 4 points at N = 128, counted twice). Each: z-test of the image mean
-// (significance 0.001, Sidak over the 3 estimators) with that allowance. Broken on purpose: with
-// bsdfPdf 0 below the surface, MIS counts the lamp twice (an image of 2x); without the (n_o / n_i)^2
-// of the BSDF every estimator gives 2.25x.
+// change against 4 x 4 points at N = 128, counted twice); so is MIS with path guiding on (the
+// guided pipelines; the guide is off at transmitting vertices). Each: z-test of the image mean
+// (significance 0.001, Sidak over the 4 renders) with that allowance. Broken on purpose (measured):
+// with bsdfPdf 0 below the surface MIS counts the lamp twice (0.754 +- 0.011, z = 33); an extra
+// 1 / eta^2 on the transmitted weight in the shade stage (the radiance scaling applied twice)
+// gives MIS 0.203 and BSDF sampling 0.176. (Dropping the BSDF's own (n_o / n_i)^2 moves the
+// quadrature with it: the smooth-limit test and the furnace catch that.)
 TEST(RoughTransmission, LightBehindARoughInterfaceAgreesUnderNeeBsdfAndMis) {
   const float alpha = 0.5f, eta = 1.5f;
   const double expected = roughInterfaceImage(alpha, eta, 8, 256);
   const double coarse = roughInterfaceImage(alpha, eta, 4, 128);
   const double allowance = 2 * std::fabs(expected - coarse);
   Scene s = emitterUnderRoughInterface(roughGlass(alpha, eta));
-  const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 3.0)));
+  const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 4.0)));
   std::uint32_t seed = 41;
-  for (LightingMode mode : {LightingMode::Mis, LightingMode::NeeOnly, LightingMode::BsdfOnly}) {
+  for (int c = 0; c < 4; ++c) {
+    const LightingMode mode = c == 1 ? LightingMode::NeeOnly : c == 2 ? LightingMode::BsdfOnly : LightingMode::Mis;
     RenderSettings rs = exactSettings(1, seed++, mode == LightingMode::NeeOnly ? 256 : 64);
     rs.lighting = mode;
+    rs.guiding = c == 3;  // the guided pipelines (the guide is off at the rough interface's vertices)
+    const std::string what = std::string(lightingModeName(mode)) + (rs.guiding ? " guided" : "");
     const test::Rendered r = test::render(s, rs);
     EXPECT_EQ(r.stats.nonFiniteSamples, 0u);
     const auto [mean, se] = imageMean(r.image);
     std::printf("[ rough transmission ] %s: image %.5f +- %.5f, expected %.5f (quadrature allowance %.1e), z = %.2f; "
                 "sampler bound violations %llu, trial failures %llu\n",
-                lightingModeName(mode), mean, se, expected, allowance, (std::fabs(mean - expected) - allowance) / se,
+                what.c_str(), mean, se, expected, allowance, (std::fabs(mean - expected) - allowance) / se,
                 (unsigned long long)r.stats.samplerBoundViolations, (unsigned long long)r.stats.samplerTrialFailures);
-    EXPECT_LT(std::fabs(mean - expected), zMax * se + allowance) << lightingModeName(mode);
+    EXPECT_LT(std::fabs(mean - expected), zMax * se + allowance) << what;
   }
   EXPECT_EQ(test::validationMessages(), 0u);
 }
