@@ -70,9 +70,12 @@ SHARED_FN uint effectiveSampler(uint strategy, uint quadSet) {
                                                                                                       : strategy;
 }
 
+// wi below the surface: 0, except for a transmitting model (modelTransmits) under the quadtree,
+// whose transmitting sets sample both discs (the other strategies sample the upper one only).
 SHARED_FN float bsdfPdf(uint strategy, uint model, uint quadSet, BrdfParams p, vec3 wo, vec3 wi) {
-  if (wo.z <= 0.0f || wi.z <= 0.0f || modelIsDelta(model)) return 0.0f;
+  if (wo.z <= 0.0f || (wi.z <= 0.0f && !(modelTransmits(model) && wi.z < 0.0f)) || modelIsDelta(model)) return 0.0f;
   uint s = effectiveSampler(strategy, quadSet);
+  if (modelTransmits(model) && wi.z < 0.0f && s != SAMPLER_QUADTREE) return 0.0f;
 #if NUSSELT_WITH_QUADTREE
   if (s == SAMPLER_QUADTREE) return quadPdf(quadSet, model, p, wo, wi);
 #endif
@@ -142,12 +145,11 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
   uint s = effectiveSampler(strategy, quadSet);
   vec3 f;
   if (!strategySample(s, model, quadSet, p, wo, u, wi, pdf, f)) return false;
-  // A transmitting model's quadtree sample below the surface (QT_SET_TRANSMITS): the path tracer
-  // does not continue inside yet (issue 18, phase 3), so the sample ends the path. The reflection
-  // stays unbiased (its samples keep weight f cos / pdf); the transmitted light is missing.
-  // (Never true for other models: their samples lie above the surface.)
-  if (wi.z < 0.0f) return false;
-  weight = f * (wi.z / pdf);
+  // A transmitting model's quadtree sample may lie below the surface (QT_SET_TRANSMITS): weight
+  // f |cos| / pdf, f the radiance BSDF with its (n_o / n_i)^2 (nothing else scales it). Other
+  // models' samples lie above the surface.
+  if (wi.z < 0.0f && !modelTransmits(model)) return false;
+  weight = f * ((modelTransmits(model) ? abs(wi.z) : wi.z) / pdf);
 #if NUSSELT_WITH_QUADTREE
   // The random-walk source's roulette: continue with the tabulated directional albedo. With
   // sampling proportional to f cos the weight's luminance is that albedo, so surviving paths of

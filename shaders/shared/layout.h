@@ -156,7 +156,9 @@ STATIC_ASSERT_SIZE(BrdfParams, 128);
 // info = (model id, MATERIAL_* flags, quadtree set index (QuadSet) or INVALID_INDEX, shade slot).
 // emission = emitted radiance (rgb), w unused.
 // components = (first GpuComponent, count, 0, 0) when MATERIAL_COMBINED (then info.x is the first
-// component's model and params/info.z are unused); (0, 0, 0, 0) otherwise.
+// component's model and params/info.z are unused); for a single transmitting model (modelTransmits:
+// rough_dielectric) (0, 0, the QuadSet of its parameters seen from the inside
+// (transmissionInsideParams) or INVALID_INDEX, 0); (0, 0, 0, 0) otherwise.
 // absorption = the volume's absorption coefficient sigma_a [1/m] (rgb; volume.h), w unused; read
 // only when MATERIAL_ABSORBING.
 struct GpuMaterial {

@@ -149,6 +149,7 @@ struct PathStep {
 // ---- The material at a hit: one interface, two implementations ----
 // ShadeMaterial      what the material needs at this hit (set up once by shadeMaterial)
 // shadeLightSamples  whether next-event estimation applies (not for delta materials)
+// shadeTransmits     whether f is not zero below the surface (light samples on both sides)
 // shadeEval          f(wi, wo) (rgb) for a light sample
 // shadeMisPdf        the density with which shadeSample would draw wi (MIS against light sampling)
 // shadeSample        the next direction, its factor and density (PathStep); false ends the walk
@@ -157,18 +158,29 @@ struct PathStep {
 // ---- A single-model material (MODEL_ID); guided where the guide has learned (guiding.h) ----
 struct ShadeMaterial {
   GpuMaterial M;
-  GuideVertex gv;  // the guide's region (path guiding): never for delta models
+  GuideVertex gv;  // the guide's region (path guiding): never for delta or transmitting models
 };
 
-ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, float transmissionR) {
+// inside: the path arrived from the inside (the back of the front face). A transmitting model
+// (modelTransmits: rough_dielectric) is then shaded in the frame turned over, with its parameters
+// seen from the inside (transmissionInsideParams: eta -> 1 / eta) and their sampler tables
+// (GpuMaterial.components.z), as the smooth dielectric takes 1 / eta there (dielectric.h).
+// The guide is off for transmitting models (alpha = 0): its mixture covers the upper hemisphere only.
+ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, float transmissionR, bool inside) {
   ShadeMaterial m;
   m.M = M;
+  if (modelTransmits(MODEL_ID) && inside) {
+    m.M.params = transmissionInsideParams(MODEL_ID, M.params);
+    m.M.info.z = M.components.z;
+  }
   m.gv = GuideVertex(0u, 0.0f);
-  if (GUIDING && !modelIsDelta(MODEL_ID)) m.gv = guideVertex(x);
+  if (GUIDING && !modelIsDelta(MODEL_ID) && !modelTransmits(MODEL_ID)) m.gv = guideVertex(x);
   return m;
 }
 
 bool shadeLightSamples(ShadeMaterial m) { return !modelIsDelta(MODEL_ID); }
+
+bool shadeTransmits(ShadeMaterial m) { return modelTransmits(MODEL_ID); }
 
 vec3 shadeEval(ShadeMaterial m, vec3 wi, vec3 wo) { return brdfEval(MODEL_ID, m.M.params, wi, wo); }
 
@@ -243,8 +255,9 @@ struct ShadeMaterial {
   bool lightSamples; // no delta flag on the material
 };
 
-// transmissionR: the transmission texture's R at the hit (transmissionAt), or -1.
-ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, float transmissionR) {
+// transmissionR: the transmission texture's R at the hit (transmissionAt), or -1. inside: unused
+// (only delta components transmit here; the renderer refuses transmitting non-delta components).
+ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, float transmissionR, bool inside) {
   ShadeMaterial m;
   m.a = vec4(0.0f);
   uint first = M.components.x;
@@ -276,6 +289,8 @@ ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, float
 }
 
 bool shadeLightSamples(ShadeMaterial m) { return m.lightSamples; }
+
+bool shadeTransmits(ShadeMaterial m) { return false; }
 
 // The sum of the non-delta components.
 vec3 shadeEval(ShadeMaterial m, vec3 wi, vec3 wo) {
@@ -365,21 +380,29 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
 #endif
 
 // ---- Next-event estimation: a light sample, its shadow ray queued with the MIS-weighted value ----
-void nextEvent(ShadeMaterial m, uint path, PathKey k, uint bounce, uint lighting, vec3 xo, vec3 ng, vec3 tt, vec3 bb,
-               vec3 ns, vec3 wo, vec3 beta) {
+// Above the geometric surface (xo: x offset along ng); a transmitting material (shadeTransmits)
+// also takes lights behind it: sampled from x itself, |cos|, the shadow ray offset to the light's
+// side (offsetRay with -ng), and only where the shading frame puts the light on the same side
+// (else light would pass through the surface on one normal and not the other).
+void nextEvent(ShadeMaterial m, uint path, PathKey k, uint bounce, uint lighting, vec3 x, vec3 xo, vec3 ng, vec3 tt,
+               vec3 bb, vec3 ns, vec3 wo, vec3 beta) {
   float uSel = pathSample1(k, rngDimension(bounce, RNG_DIM_LIGHT_SELECT));
   vec2 uPt = pathSample2(k, rngDimension(bounce, RNG_DIM_LIGHT_POINT));
   LightSample ls;
-  if (sampleLight(xo, uSel, uPt, ls) && dot(ls.wi, ng) > 0.0f) {
+  bool transmits = shadeTransmits(m);
+  if (sampleLight(transmits ? x : xo, uSel, uPt, ls) &&
+      (dot(ls.wi, ng) > 0.0f || (transmits && dot(ls.wi, ng) < 0.0f))) {
+    bool behind = transmits && dot(ls.wi, ng) < 0.0f;
     vec3 wiL = toLocal(ls.wi, tt, bb, ns);
+    if (transmits && (wiL.z < 0.0f) != behind) return;
     vec3 f = shadeEval(m, wiL, wo);
-    float cosS = max(wiL.z, 0.0f);
+    float cosS = transmits ? abs(wiL.z) : max(wiL.z, 0.0f);
     vec3 c = beta * f * cosS * ls.value;
     if (ls.pdf > 0.0f && lighting == LIGHTING_MIS) c *= powerHeuristic(ls.pdf, shadeMisPdf(m, wo, wiL, ls.wi));
     if (max(c.x, max(c.y, c.z)) > 0.0f) {
       // Stop short of the light so that the emitter itself never occludes.
       float tmax = ls.dist < 1.0e38f ? ls.dist * (1.0f - 1e-4f) : ls.dist;
-      g.shadowOrigin.v[path] = vec4(xo, tmax);
+      g.shadowOrigin.v[path] = vec4(behind ? offsetRay(x, -ng) : xo, tmax);
       g.shadowDirection.v[path] = vec4(ls.wi, 0.0f);
       g.shadowRadiance.v[path] = vec4(c, 0.0f);
       queuePush(QUEUE_SHADOW0 + (bounce & 1u), path);
@@ -389,7 +412,8 @@ void nextEvent(ShadeMaterial m, uint path, PathKey k, uint bounce, uint lighting
 
 // ---- Path continuation: the sampled step becomes the next ray, or the walk ends ----
 // Reflection must stay above the geometric surface (else light leaks through it); refraction
-// (only delta models transmit) must cross it, and leaves from the other side. Then the throughput
+// (delta models and transmitting ones: modelTransmits) must cross it, and leaves from the other
+// side (offsetRay with -ng). Then the throughput
 // roulette (the default; the albedo roulette decided in shadeSample): survivors are divided by
 // the probability.
 void continuePath(PathStep s, uint path, uint bounce, uint roulette, vec3 x, vec3 xo, vec3 ng, vec3 tt, vec3 bb,
@@ -490,9 +514,9 @@ void main() {
 #if SHADE_COMBINED
   if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) transmissionR = transmissionAt(S.info.x, tri, hit.y, hit.z);
 #endif
-  ShadeMaterial m = shadeMaterial(M, x, wo, roulette, transmissionR);
+  ShadeMaterial m = shadeMaterial(M, x, wo, roulette, transmissionR, !frontFace);
   if (!last && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m))
-    nextEvent(m, path, key, bounce, lighting, xo, ng, tt, bb, ns, wo, beta);
+    nextEvent(m, path, key, bounce, lighting, x, xo, ng, tt, bb, ns, wo, beta);
 
   g.pathRadiance.v[path].xyz += L;
   if (last) return;

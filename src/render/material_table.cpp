@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "../../shaders/shared/brdf/dispatch.h"
 #include "../../shaders/shared/layout.h"
 #include "brdf/albedo.h"
 #include "brdf/merl.h"
@@ -69,16 +70,22 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     if (m.components.size() > MAX_COMPONENTS)
       throw Error("material " + m.name + ": " + std::to_string(m.components.size()) + " components, at most " +
                   std::to_string(MAX_COMPONENTS));
-    // A transmitting non-delta model (rough_dielectric) has its BSDF and its generic sampler over
-    // both hemispheres (nusselt sample, albedo, bench), but the shade stage does not continue a
-    // path below the surface yet: rendering it would silently drop its transmission.
-    for (std::size_t k = 0; k < std::max<std::size_t>(m.components.size(), 1); ++k) {
-      const std::uint32_t model = m.combined() ? m.components[k].model : m.model;
-      if (modelById(model).transmits && !modelById(model).delta)
-        throw Error("material " + m.name + ": model " + modelById(model).name +
-                    " transmits through a rough surface, which the path tracer does not render yet (its sampler "
-                    "and albedo are available in nusselt sample and nusselt albedo; docs/models.md)");
-    }
+    // A transmitting non-delta model (rough_dielectric) renders alone and with the quadtree
+    // sampler, whose transmitting sets cover both hemispheres (the shade stage continues paths
+    // and takes light samples below the surface, from either side). Refused rather than rendered
+    // as its reflection alone: as a component of a combined material (the component choice, its
+    // albedo tables and the MIS density cover the upper hemisphere only), and under the other
+    // strategies (they sample the upper hemisphere only). docs/models.md, "rough_dielectric".
+    for (const MaterialComponent& c : m.components)
+      if (shared::modelTransmits(c.model) && !modelById(c.model).delta)
+        throw Error("material " + m.name + ": model " + modelById(c.model).name +
+                    " as a component of a combined material is not rendered (rough transmission renders as a "
+                    "material of its own; docs/models.md)");
+    if (!m.combined() && shared::modelTransmits(m.model) && settings.sampler != SamplerKind::Quadtree)
+      throw Error("material " + m.name + ": model " + modelById(m.model).name +
+                  " transmits through a rough surface, which only the quadtree sampler samples (--sampler "
+                  "quadtree); the " + std::string(enumName(kSamplerNames, settings.sampler)) +
+                  " strategy samples the upper hemisphere only");
     std::vector<std::uint32_t> key = slotKey(m);
     if (std::find(m_slotKeys.begin(), m_slotKeys.end(), key) == m_slotKeys.end()) m_slotKeys.push_back(key);
   }
@@ -96,8 +103,9 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
   // (identical (model, params) share a set), built before the materials are packed ----
   struct TableUse {
     std::uint32_t material;
-    int component;  // -1: the material itself
+    int component;  // -1: the material itself; kInsideUse: a transmitting material seen from the inside
   };
+  constexpr int kInsideUse = -2;
   std::vector<std::pair<std::uint32_t, shared::BrdfParams>> toBuild;
   std::vector<TableUse> uses;
   if (settings.sampler == SamplerKind::Quadtree || settings.sampler == SamplerKind::Tabulated)
@@ -109,6 +117,12 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
       if (!m.combined() && !modelById(m.model).delta && !textureUse(m, scene).paramsVary()) {
         toBuild.push_back({m.model, m.params});
         uses.push_back({static_cast<std::uint32_t>(i), -1});
+        // A transmitting model's tables for the inside too (its parameters seen from there,
+        // transmissionInsideParams: rough_dielectric's 1 / eta), GpuMaterial.components.z.
+        if (shared::modelTransmits(m.model)) {
+          toBuild.push_back({m.model, shared::transmissionInsideParams(m.model, m.params)});
+          uses.push_back({static_cast<std::uint32_t>(i), kInsideUse});
+        }
       }
       for (std::size_t k = 0; k < m.components.size(); ++k)
         if (!modelById(m.components[k].model).delta) {
@@ -187,6 +201,7 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     dst.params = src.params;
     if (used[i] && !src.combined()) gpuMeasured(src.model, dst.params);
     dst.components = glm::uvec4(0u);
+    if (!src.combined() && shared::modelTransmits(src.model)) dst.components.z = setFor(material, kInsideUse);
     if (!src.combined() || !used[i]) continue;
     dst.components = glm::uvec4(static_cast<std::uint32_t>(components.size()),
                                 static_cast<std::uint32_t>(src.components.size()), 0u, 0u);

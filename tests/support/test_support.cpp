@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "../../shaders/shared/brdf/dispatch.h"
 #include "cli/cli_common.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
@@ -337,6 +338,32 @@ std::string compareImagesStatistically(const Image& a, const Image& b, double ce
      << " at pixel (" << worstX << ", " << worstY << "): luminance " << worstA << " (variance " << worstVa << ") vs "
      << worstB << " (variance " << worstVb << ")";
   return os.str();
+}
+
+RoughSplit roughDielectricSplit(float alpha, float eta, glm::vec3 wo, int N, const std::function<bool(glm::vec3)>& accept) {
+  RoughSplit r;
+  const double no = wo.z > 0 ? 1.0 : eta;
+  for (int side = 0; side < 2; ++side) {
+    double acc = 0;
+    for (int a = 0; a < N; ++a) {
+      const double th = (a + 0.5) / N * 0.5 * M_PI, mu = std::cos(th), st = std::sin(th);
+      for (int b = 0; b < 2 * N; ++b) {
+        const double ph = (b + 0.5) / (2 * N) * 2 * M_PI;
+        const glm::vec3 wi(float(st * std::cos(ph)), float(st * std::sin(ph)), float(side == 0 ? mu : -mu));
+        if (accept && !accept(wi)) continue;
+        acc += shared::roughDielectricF(alpha, eta, wi, wo) * mu * st;  // f |cos| dw = f cos sin dtheta dphi
+      }
+    }
+    acc *= (0.5 * M_PI / N) * (M_PI / N);
+    const double ni = side == 0 ? 1.0 : eta;
+    if ((side == 0) == (wo.z > 0)) {
+      r.R = acc;
+    } else {
+      r.Trad = acc;
+      r.Tenergy = acc * (ni / no) * (ni / no);
+    }
+  }
+  return r;
 }
 
 }  // namespace nusselt::test

@@ -2,6 +2,7 @@
 // binary (validation layer on when NUSSELT_VALIDATION=1, as ctest sets it), rendering a scene to
 // an image with its per-pixel variance, and statistical comparisons.
 #pragma once
+#include <functional>
 #include <random>
 #include <string>
 #include <utility>
@@ -94,6 +95,19 @@ class BrdfParityKernel {
   std::mt19937 m_prng{99};
   std::uniform_int_distribution<int> m_step{-4, 4};
 };
+
+// The rough dielectric's split for the known direction wo (either side of its frame; eta = n_inside /
+// n_outside; shaders/shared/brdf/rough_dielectric.h) by the midpoint rule over each hemisphere in
+// (theta_i, phi), N x 2N cells: R = the integral of f |cos| over
+// wo's hemisphere, Trad = over the other one (f as the renderer uses it, with its (n_o / n_i)^2),
+// Tenergy = Trad (n_i / n_o)^2 (the transmitted energy); loss = 1 - R - Tenergy, the Smith term's
+// single-scattering loss. accept (optional): only the directions wi it accepts count (a light's extent).
+struct RoughSplit {
+  double R = 0, Trad = 0, Tenergy = 0;
+  double loss() const { return 1.0 - R - Tenergy; }
+};
+RoughSplit roughDielectricSplit(float alpha, float eta, glm::vec3 wo, int N,
+                                const std::function<bool(glm::vec3)>& accept = {});
 
 // Two-sided p-value of a standard normal z.
 double normalPValue(double z);

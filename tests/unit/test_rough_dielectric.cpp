@@ -242,16 +242,32 @@ TEST(RoughDielectric, ReciprocityAndSides) {
   EXPECT_GT(nonzero, 10000);
 }
 
-// The model's catalogue entry: transmitting, not delta; eval through the dispatch equals the
-// scalar formula; zero in the plane of the surface.
+// The model's catalogue entry: transmitting, not delta, the shaders' modelTransmits equal to the
+// catalogue for every model; the parameters seen from the inside; eval through the dispatch equals
+// the scalar formula; zero in the plane of the surface.
 TEST(RoughDielectric, CatalogueAndDispatch) {
   const ModelSpec* m = findModel("rough_dielectric");
   ASSERT_NE(m, nullptr);
   EXPECT_TRUE(m->transmits);
   EXPECT_FALSE(m->delta);
-  for (const ModelSpec& o : allModels())
+  for (const ModelSpec& o : allModels()) {
     if (o.id != m->id) EXPECT_FALSE(o.transmits) << o.name;
+    // The shaders' trait (dispatch.h) is the catalogue's.
+    EXPECT_EQ(shared::modelTransmits(o.id), o.transmits) << o.name;
+  }
   BrdfParams p = packParams(*m, typicalParams(*m), "rough_dielectric");
+  // Seen from the inside: eta -> 1 / eta, so that f(wi, wo) = f'(flipZ wi, flipZ wo) (the renderer's
+  // turned-over frame); etaScale (n_wi / n_wo)^2 of a crossing from either side.
+  BrdfParams q = shared::transmissionInsideParams(m->id, p);
+  EXPECT_EQ(shared::brdfParam(q, ROUGH_DIELECTRIC_ETA), 1.0f / 1.5f);
+  EXPECT_EQ(shared::brdfParam(q, ROUGH_DIELECTRIC_ALPHA), 0.2f);
+  for (auto [wi, wo] : {std::pair{flipZ(dirAt(20, 180)), dirAt(30)}, std::pair{dirAt(50, 90), dirAt(10)}}) {
+    const float a = shared::brdfEval(m->id, p, wi, wo).x, b = shared::brdfEval(m->id, q, flipZ(wi), flipZ(wo)).x;
+    EXPECT_GT(a, 0.0f);
+    EXPECT_NEAR(a, b, 1e-5f * a);
+  }
+  EXPECT_FLOAT_EQ(shared::transmissionEtaScale(m->id, p, false), 1.5f * 1.5f);
+  EXPECT_FLOAT_EQ(shared::transmissionEtaScale(m->id, q, true), 1.0f / (1.5f * 1.5f));
   vec3 wo = dirAt(30), wi = flipZ(dirAt(20, 180));
   EXPECT_EQ(shared::brdfEval(MODEL_ROUGH_DIELECTRIC, p, wi, wo).x, float(F(0.2f, 1.5f, wi, wo)));
   EXPECT_GT(F(0.2f, 1.5f, wi, wo), 0.0);
@@ -303,27 +319,33 @@ TEST(RoughDielectric, LowerDiscTreeTotalsAndEnvelopes) {
 // violations, no trial failures. (Quadtree.ChiSquareCpu runs these cases too, within its matrix.)
 // Then the same test must reject a broken sampler: the tables' lower masses halved, which halves
 // the probability of the lower disc while its trees (and so the density within it) stay as they
-// are; its pdf claims f |cos| / (a_up + a_low / 2) (a sampler that can fail).
+// are; its pdf claims f |cos| / (a_up + a_low / 2) (a sampler that can fail). The typical set seen
+// from the inside (eta 1 / 1.5, the renderer's set for paths inside) is the third set (Bonferroni
+// over 15 cases).
 TEST(RoughDielectric, ChiSquareBothDiscs) {
   const ModelSpec* m = findModel("rough_dielectric");
   const std::uint32_t n = qttest::kSamples;
   const std::vector<double> angles = {0.0, 30.0, 60.0, 85.0, 37.3};
-  const double alpha = 0.01 / (2.0 * double(angles.size()));
+  const double alpha = 0.01 / (3.0 * double(angles.size()));
   int brokenRejected = 0, brokenCases = 0;
-  for (int hard = 0; hard < 2; ++hard) {
-    BrdfParams p = packParams(*m, hard ? hardParams(*m) : typicalParams(*m), "rough_dielectric");
+  // hard = 2: the typical set seen from the inside (eta 1 / 1.5: transmissionInsideParams), the
+  // renderer's second set for paths inside the object.
+  for (int hard = 0; hard < 3; ++hard) {
+    BrdfParams p = packParams(*m, hard == 1 ? hardParams(*m) : typicalParams(*m), "rough_dielectric");
+    if (hard == 2) p = shared::transmissionInsideParams(m->id, p);
     std::vector<std::uint32_t> idx;
     quadtree::SamplerTables t = quadtree::buildSamplerTables({{m->id, p}}, qttest::testSettings(), idx);
     ASSERT_EQ(t.sets.size(), 1u);
     ASSERT_NE(t.sets[0].info.w & QT_SET_TRANSMITS, 0u);
     ASSERT_EQ(t.tables.size(), 2u * t.sets[0].info.y * t.sets[0].info.z);
     for (double th : angles) {
-      qttest::Case c{"rough_dielectric", hard != 0, th, 0.0};
+      qttest::Case c{"rough_dielectric", hard == 1, th, 0.0};
       vec3 v = qttest::knownDirection(c);
+      const std::string label = (hard == 2 ? "inside " : "") + c.name();
       quadtree::SampleBatch b = quadtree::sampleCpu(t, 0, m->id, p, v, n, 1234u);
       quadtree::SampleBatch pilot = quadtree::sampleCpu(t, 0, m->id, p, v, qttest::kPilotSamples, 99u);
-      EXPECT_EQ(b.boundViolations, 0u) << c.name();
-      EXPECT_EQ(b.trialFailures, 0u) << c.name();
+      EXPECT_EQ(b.boundViolations, 0u) << label;
+      EXPECT_EQ(b.trialFailures, 0u) << label;
       qttest::Chi2Result r = qttest::quadChiSquare(t, 0, m->id, p, v, pilot.wPdf, b.wPdf);
       bool onTable = std::fmod(th, 1.0) == 0.0;
       std::uint32_t k = std::uint32_t(std::lround(th));
@@ -340,14 +362,14 @@ TEST(RoughDielectric, ChiSquareBothDiscs) {
       double share = aLow / (aUp + aLow), z = (below / ok - share) / std::sqrt(share * (1 - share) / ok);
       std::printf("[rough_dielectric chi2] %-44s p=%.3g chi2=%.1f dof=%d sum(pdf)=%.5f below %.5f (a_low/a %.5f, z=%.2f) "
                   "weight/a in [%.5f, %.5f] evals/sample=%.3f\n",
-                  c.name().c_str(), r.pValue, r.chi2, r.dof, r.expectedTotal, below / ok, share, z, lo, hi,
+                  label.c_str(), r.pValue, r.chi2, r.dof, r.expectedTotal, below / ok, share, z, lo, hi,
                   double(b.evaluations) / n);
-      EXPECT_NEAR(r.expectedTotal, 1.0, 2e-4) << c.name();
-      EXPECT_GE(r.pValue, alpha) << c.name() << "\n" << r.dump;
+      EXPECT_NEAR(r.expectedTotal, 1.0, 2e-4) << label;
+      EXPECT_GE(r.pValue, alpha) << label << "\n" << r.dump;
       if (onTable) {
-        EXPECT_LT(std::abs(z), 5.0) << c.name();
-        EXPECT_NEAR(lo, 1.0, 2e-3) << c.name();
-        EXPECT_NEAR(hi, 1.0, 2e-3) << c.name();
+        EXPECT_LT(std::abs(z), 5.0) << label;
+        EXPECT_NEAR(lo, 1.0, 2e-3) << label;
+        EXPECT_NEAR(hi, 1.0, 2e-3) << label;
       }
       // The broken sampler (tables' lower masses halved), on tables, the typical set.
       if (!onTable || hard) continue;
@@ -357,7 +379,7 @@ TEST(RoughDielectric, ChiSquareBothDiscs) {
       quadtree::SampleBatch bp = quadtree::sampleCpu(broken, 0, m->id, p, v, qttest::kPilotSamples, 99u);
       qttest::Chi2Result rb = qttest::quadChiSquare(broken, 0, m->id, p, v, bp.wPdf, bb.wPdf);
       std::printf("[rough_dielectric chi2] broken (lower disc probability halved) %s: p=%.3g chi2=%.1f dof=%d\n",
-                  c.name().c_str(), rb.pValue, rb.chi2, rb.dof);
+                  label.c_str(), rb.pValue, rb.chi2, rb.dof);
       ++brokenCases;
       if (rb.pValue < alpha) ++brokenRejected;
     }

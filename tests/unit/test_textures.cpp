@@ -540,7 +540,7 @@ TEST(GltfTextures, TransmissionBecomesTheDielectric) {
   EXPECT_FLOAT_EQ(m.components[1].weight, 0.6f);
   EXPECT_FLOAT_EQ(m.components[1].params.v[DIELECTRIC_ETA / 4][DIELECTRIC_ETA % 4], 1.33f);
   EXPECT_FALSE(hasWarning(s, "read but not rendered yet"));
-  j["materials"][0] = Json::parse(R"({"name": "glass", "pbrMetallicRoughness": {"metallicFactor": 0},
+  j["materials"][0] = Json::parse(R"({"name": "glass", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
     "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
                    "KHR_materials_volume": {"thicknessFactor": 0.1}}})");
   const Material g = loadJson(j).materials[0];
@@ -557,6 +557,58 @@ TEST(GltfTextures, TransmissionBecomesTheDielectric) {
     EXPECT_EQ(t.components[1].model, MODEL_THIN_DIELECTRIC) << volume;
     EXPECT_FLOAT_EQ(t.components[1].params.v[THIN_DIELECTRIC_ETA / 4][THIN_DIELECTRIC_ETA % 4], 1.7f);
   }
+}
+
+// Rough transmission (roughnessFactor r > 0) in a refracting volume (thicknessFactor > 0) with
+// w = transmissionFactor x (1 - metallic) = 1 and no transmissionTexture: rough_dielectric alone,
+// alpha = r^2, eta = ior (default 1.5; clamped to the model's [1.01, 4] with a warning), the
+// volume's absorption as for the smooth dielectric. glTF's default roughnessFactor is 1. The
+// smooth case (r = 0) stays the dielectric; partial, textured or thin-walled rough transmission
+// stays smooth and is named in a warning.
+TEST(GltfTextures, RoughTransmissionBecomesRoughDielectric) {
+  Json j = texturedQuad();
+  j["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"};
+  auto material = [&](const std::string& pbr, const std::string& extensions) {
+    j["materials"][0] = Json::parse(R"({"name": "frosted", "pbrMetallicRoughness": {"metallicFactor": 0)" + pbr +
+                                    R"(}, "extensions": {)" + extensions + "}}");
+    return loadJson(j);
+  };
+  const std::string full = R"("KHR_materials_transmission": {"transmissionFactor": 1})";
+  const std::string volume = R"(, "KHR_materials_volume": {"thicknessFactor": 0.1, "attenuationDistance": 0.5,
+                                                            "attenuationColor": [1, 0.5, 0.1]})";
+  auto param = [](const Material& m, std::uint32_t i) { return m.params.v[i / 4][i % 4]; };
+  Scene s = material(R"(, "roughnessFactor": 0.5)", full + R"(, "KHR_materials_ior": {"ior": 1.33})" + volume);
+  const Material& m = s.materials[0];
+  EXPECT_FALSE(m.combined());
+  EXPECT_EQ(m.model, MODEL_ROUGH_DIELECTRIC);
+  EXPECT_FLOAT_EQ(param(m, ROUGH_DIELECTRIC_ALPHA), 0.25f);
+  EXPECT_FLOAT_EQ(param(m, ROUGH_DIELECTRIC_ETA), 1.33f);
+  EXPECT_FLOAT_EQ(m.absorption.y, float(-std::log(0.5) / 0.5));
+  EXPECT_FALSE(hasWarning(s, "rendered as smooth transmission"));
+  EXPECT_FALSE(hasWarning(s, "read but not rendered yet"));
+  // glTF's default roughness 1 and ior 1.5.
+  const Material d = material("", full + volume).materials[0];
+  EXPECT_EQ(d.model, MODEL_ROUGH_DIELECTRIC);
+  EXPECT_FLOAT_EQ(param(d, ROUGH_DIELECTRIC_ALPHA), 1.0f);
+  EXPECT_FLOAT_EQ(param(d, ROUGH_DIELECTRIC_ETA), 1.5f);
+  // alpha clamped to 0.001 (r < 0.0316), ior 1 to the model's 1.01 (named).
+  Scene c = material(R"(, "roughnessFactor": 0.01)", full + R"(, "KHR_materials_ior": {"ior": 1.0})" + volume);
+  EXPECT_FLOAT_EQ(param(c.materials[0], ROUGH_DIELECTRIC_ALPHA), 0.001f);
+  EXPECT_FLOAT_EQ(param(c.materials[0], ROUGH_DIELECTRIC_ETA), 1.01f);
+  EXPECT_TRUE(hasWarning(c, "KHR_materials_ior 1 of a rough transmitting material is rendered as 1.01"));
+  // Smooth: the dielectric, as before.
+  const Material g = material(R"(, "roughnessFactor": 0)", full + volume).materials[0];
+  EXPECT_EQ(g.model, MODEL_DIELECTRIC);
+  // Partial rough transmission: the smooth combination, named.
+  Scene p = material(R"(, "roughnessFactor": 0.5)", R"("KHR_materials_transmission": {"transmissionFactor": 0.5})" + volume);
+  ASSERT_EQ(p.materials[0].components.size(), 2u);
+  EXPECT_EQ(p.materials[0].components[1].model, MODEL_DIELECTRIC);
+  EXPECT_TRUE(hasWarning(p, "roughnessFactor > 0 of a transmitting material is rendered as smooth transmission when "
+                            "transmissionFactor x (1 - metallic) < 1"));
+  // Thin-walled rough transmission: thin_dielectric, named.
+  Scene t = material(R"(, "roughnessFactor": 0.5)", full);
+  EXPECT_EQ(t.materials[0].model, MODEL_THIN_DIELECTRIC);
+  EXPECT_TRUE(hasWarning(t, "rendered as smooth transmission when it is thin-walled"));
 }
 
 // transmissionTexture applies to the transmission combination: the material stays combined
@@ -592,7 +644,7 @@ TEST(GltfTextures, VolumeAttenuationBecomesTheAbsorptionCoefficient) {
   Json j = texturedQuad();
   j["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_volume"};
   auto glass = [&](const std::string& volume) {
-    j["materials"][0] = Json::parse(R"({"name": "tinted", "pbrMetallicRoughness": {"metallicFactor": 0},
+    j["materials"][0] = Json::parse(R"({"name": "tinted", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
       "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
                      "KHR_materials_volume": )" + volume + "}}");
     return j;

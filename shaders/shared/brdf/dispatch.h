@@ -21,6 +21,20 @@ SHARED_FN bool modelIsDelta(uint model) {
   return false;
 }
 
+// Models whose f is not zero below the surface (<NAME>_TRANSMITS 1 in the model's header,
+// ModelSpec::transmits; RoughDielectric.CatalogueAndDispatch keeps the two equal):
+// rough_dielectric. A sample or a light sample of theirs may lie on either side; their
+// parameters differ with the side the path is on (transmissionInsideParams).
+SHARED_FN bool modelTransmits(uint model) { return ROUGH_DIELECTRIC_TRANSMITS != 0 && model == MODEL_ROUGH_DIELECTRIC; }
+
+// The parameters of a transmitting model seen from the inside (the -z side of its frame) in the
+// frame turned over (inside = +z), so that f(wi, wo; p) = f(flipZ(wi), flipZ(wo); inside(p)); p for
+// every other model.
+SHARED_FN BrdfParams transmissionInsideParams(uint model, BrdfParams p) {
+  if (model == MODEL_ROUGH_DIELECTRIC) return roughDielectricInside(p);
+  return p;
+}
+
 // BRDF value f(wi, wo) [1/sr] in the local frame (normal +z); wi towards the light, wo towards
 // the viewer. Zero for delta models and for directions below the surface.
 SHARED_FN vec3 brdfEval(uint model, BrdfParams p, vec3 wi, vec3 wo) {
@@ -68,8 +82,11 @@ SHARED_FN float deltaChoiceAlbedo(uint model, BrdfParams p, vec3 wo, bool larges
 #define NUSSELT_ETA_SCALE(id, NAME, fn) NUSSELT_CAT(NUSSELT_ETA_SCALE_, NAME##_DELTA)(NAME, fn)
 // The factor by which a refraction's radiance scaling (n_wo / n_wi)^2 is undone for the throughput
 // roulette (pbrt's and Mitsuba's etaScale): (n_wi / n_wo)^2 for a sample of `model` that crossed the
-// surface, 1 for everything else (only delta models transmit).
+// surface, 1 for everything else. Delta models take their parameters and `inside`; a transmitting
+// non-delta model (modelTransmits) its parameters as seen from wo's side (transmissionInsideParams
+// applied inside), which already say the side.
 SHARED_FN float transmissionEtaScale(uint model, BrdfParams p, bool inside) {
+  if (model == MODEL_ROUGH_DIELECTRIC) return roughDielectricTransmissionEtaScale(p);
   switch (model) {
     NUSSELT_DISPATCH_MODELS(NUSSELT_ETA_SCALE)
     default: break;

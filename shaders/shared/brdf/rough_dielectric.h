@@ -87,14 +87,32 @@ SHARED_FN vec3 roughDielectricEval(BrdfParams p, vec3 wi, vec3 wo) {
   return vec3(roughDielectricF(alpha, eta, wi, wo));
 }
 
+// The parameters seen from the inside, in the frame turned over so that the inside is +z (the
+// path tracer's local frame on the side the path arrived from): eta -> 1 / eta, by the symmetry of
+// the sides above. The renderer builds the sampler's tables for these too (material_table.cpp).
+SHARED_FN BrdfParams roughDielectricInside(BrdfParams p) {
+  BrdfParams q = p;
+  q.v[ROUGH_DIELECTRIC_ETA / 4u][ROUGH_DIELECTRIC_ETA % 4u] = 1.0f / brdfParam(p, ROUGH_DIELECTRIC_ETA);
+  return q;
+}
+
+// (n_wi / n_wo)^2 of a sample across the surface, p as seen from wo's side (roughDielectricInside
+// from the inside): eta^2. The throughput roulette's etaScale (bsdf_sampling.h), which undoes the
+// (n_o / n_i)^2 that f carries; not a factor of the path's weight.
+SHARED_FN float roughDielectricTransmissionEtaScale(BrdfParams p) {
+  float eta = brdfParam(p, ROUGH_DIELECTRIC_ETA);
+  return eta * eta;
+}
+
 SHARED_END
 
 // ---- Traits read by the model list (models.h) ----
 // ROUGH_DIELECTRIC_DELTA: 0 (evaluated and light-sampled).
 // ROUGH_DIELECTRIC_ANALYTIC: 0: the analytic strategy samples the cosine.
-// ROUGH_DIELECTRIC_TRANSMITS: 1: f is not zero below the surface (wi.z < 0 for wo.z > 0). Until the
-//   generic sampler covers the lower hemisphere (issue 18, phase 2) the samplers and the path
-//   tracer see only its reflection: the transmitted part is missing from renders.
+// ROUGH_DIELECTRIC_TRANSMITS: 1: f is not zero below the surface (wi.z < 0 for wo.z > 0). The
+//   quadtree sampler covers both discs (QT_SET_TRANSMITS); the path tracer samples and takes light
+//   samples on both sides (modelTransmits in dispatch.h; shade_body.glsl). The other strategies
+//   sample the upper hemisphere only: renders refuse them for this model (material_table.cpp).
 #define ROUGH_DIELECTRIC_DELTA 0
 #define ROUGH_DIELECTRIC_ANALYTIC 0
 #define ROUGH_DIELECTRIC_TRANSMITS 1
