@@ -44,7 +44,7 @@ struct SceneSummary {
 
 // The traversal a render with `requested` uses on this context. Auto: ray queries where the
 // device offers them and is a GPU; the GLSL BVH on CPU devices (lavapipe runs its ray-query
-// traversal as shader code, and there the GLSL BVH measured 1.8-3x faster: docs/performance.md)
+// traversal as shader code, and there the GLSL BVH measured 1.6-2.2x faster: docs/performance.md)
 // and on devices without ray queries. Throws nusselt::Error for RayQuery on a context without them.
 Traversal resolveTraversal(const vk::Context& ctx, Traversal requested);
 
