@@ -1,6 +1,7 @@
 #include "cli/cli_common.h"
 #include "scene/default_scene.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "brdf/merl.h"
@@ -43,6 +44,13 @@ Scene loadSceneOrDefault(const std::string& path, const std::string& camera) {
   opts.cameraName = camera;
   if (path.empty()) return loadDefaultScene(opts);
   return loadScene(path, opts);
+}
+
+void imageSize(const Scene& scene, std::uint32_t width, std::uint32_t height, std::uint32_t defaultWidth,
+               std::uint32_t& outWidth, std::uint32_t& outHeight) {
+  const float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
+  outWidth = width ? width : (height ? std::max(1u, unsigned(height * aspect + 0.5f)) : defaultWidth);
+  outHeight = height ? height : std::max(1u, unsigned(outWidth / aspect + 0.5f));
 }
 
 void printSceneWarnings(const Scene& scene, bool quiet) {

@@ -2,6 +2,7 @@
 // (a file or the built-in Cornell box). The stop signal is in util/stop_signal.h.
 #pragma once
 #include <atomic>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,10 @@ void checkOutputPath(const std::string& path, const std::string& option);
 
 // The scene at `path`, or the built-in Cornell box when `path` is empty.
 Scene loadSceneOrDefault(const std::string& path, const std::string& camera);
+// The image size of a command's --width and --height (0: not given): a side not given follows the
+// camera's aspect ratio from the other, and with neither the width is defaultWidth.
+void imageSize(const Scene& scene, std::uint32_t width, std::uint32_t height, std::uint32_t defaultWidth,
+               std::uint32_t& outWidth, std::uint32_t& outHeight);
 
 // The parameter block of a measured model (merl) from --file: throws nusselt::Error when the file
 // is missing or bad (naming it), or when --param options were given (a table has no parameters).

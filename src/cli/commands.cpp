@@ -144,10 +144,7 @@ int renderCommand(const RenderArgs& a) {
   if (s.guiding && !a.resume.empty())
     throw Error("--resume with --guiding on: a guided render cannot be resumed yet (its guide is not in the file; "
                 "issue 16)");
-  // Image size: defaults follow the camera's aspect ratio when only one side (or none) is given.
-  float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
-  s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u);
-  s.height = a.height ? a.height : std::max(1u, unsigned(s.width / aspect + 0.5f));
+  imageSize(scene, a.width, a.height, 512u, s.width, s.height);
   // The samples to take: --spp, or without it and with --time as many as the budget allows.
   const std::uint32_t targetSpp = a.timeBudget > 0 && !a.sppGiven ? (1u << 30) : a.spp;
   s.spp = targetSpp;

@@ -113,9 +113,7 @@ int guideViewCommand(const GuideViewArgs& a) {
   RenderSettings s;
   s.seed = a.seed;
   s.maxDepth = a.maxDepth;
-  const float aspect = scene.hasCamera && scene.camera.aspectRatio > 0 ? scene.camera.aspectRatio : 1.0f;
-  s.width = a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 128u);
-  s.height = a.height ? a.height : std::max(1u, unsigned(s.width / aspect + 0.5f));
+  imageSize(scene, a.width, a.height, 128u, s.width, s.height);
   const std::uint32_t px = a.pixel[0], py = a.pixel[1];
   if (px >= s.width || py >= s.height)
     throw Error("--pixel " + std::to_string(px) + " " + std::to_string(py) + ": outside the " + std::to_string(s.width) +

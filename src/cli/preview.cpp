@@ -687,9 +687,9 @@ int Preview::run() {
   m_settings.spp = 1;
   m_exposure = a.exposure;
   m_reinhard = a.tonemap == "reinhard";
-  float aspect = m_scene.hasCamera && m_scene.camera.aspectRatio > 0 ? m_scene.camera.aspectRatio : 1.0f;
-  int width = int(a.width ? a.width : (a.height ? std::max(1u, unsigned(a.height * aspect + 0.5f)) : 512u));
-  int height = int(a.height ? a.height : std::max(1u, unsigned(width / aspect + 0.5f)));
+  std::uint32_t imageWidth = 0, imageHeight = 0;
+  imageSize(m_scene, a.width, a.height, 512u, imageWidth, imageHeight);
+  int width = int(imageWidth), height = int(imageHeight);
 
   glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
   m_window = glfwCreateWindow(width, height, "nusselt preview", nullptr, nullptr);
