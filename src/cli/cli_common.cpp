@@ -147,4 +147,11 @@ void applyEnvironmentOptions(Scene& scene, const EnvironmentArgs& a, bool quiet)
   scene.environment = std::move(e);
 }
 
+Scene loadCommandScene(const std::string& path, const std::string& camera, const EnvironmentArgs& env, bool quiet) {
+  Scene scene = loadSceneOrDefault(path, camera);
+  printSceneWarnings(scene, quiet);
+  applyEnvironmentOptions(scene, env, quiet);
+  return scene;
+}
+
 }  // namespace nusselt

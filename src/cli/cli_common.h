@@ -52,5 +52,8 @@ void addEnvironmentOptions(CLI::App& app, EnvironmentArgs& args);
 // light, black background) gets the default, a uniform white environment of radiance 1, and a
 // warning naming the options. Throws nusselt::Error naming the option or the file on bad input.
 void applyEnvironmentOptions(Scene& scene, const EnvironmentArgs& args, bool quiet);
+// The scene of a rendering command (render, preview, guide-view): loadSceneOrDefault, its
+// warnings (printSceneWarnings) and the environment options (applyEnvironmentOptions).
+Scene loadCommandScene(const std::string& path, const std::string& camera, const EnvironmentArgs& env, bool quiet);
 
 }  // namespace nusselt

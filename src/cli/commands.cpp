@@ -99,9 +99,7 @@ int renderCommand(const RenderArgs& a) {
   // A signal from here on is handled: before the first pass it just ends without output.
   ScopedStopSignals signals;
 
-  Scene scene = loadSceneOrDefault(a.scene, a.camera);
-  printSceneWarnings(scene, a.quiet);
-  applyEnvironmentOptions(scene, a.env, a.quiet);
+  Scene scene = loadCommandScene(a.scene, a.camera, a.env, a.quiet);
 
   RenderSettings s;
   s.seed = a.seed;

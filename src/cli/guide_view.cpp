@@ -106,9 +106,7 @@ int guideViewCommand(const GuideViewArgs& a) {
   if (!a.exr.empty()) checkOutputPath(a.exr, "--exr");
   ScopedStopSignals signals;
 
-  Scene scene = loadSceneOrDefault(a.scene, a.camera);
-  printSceneWarnings(scene, a.quiet);
-  applyEnvironmentOptions(scene, a.env, a.quiet);
+  Scene scene = loadCommandScene(a.scene, a.camera, a.env, a.quiet);
 
   RenderSettings s;
   s.seed = a.seed;

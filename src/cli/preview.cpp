@@ -676,9 +676,7 @@ int Preview::run() {
   const char** exts = glfwGetRequiredInstanceExtensions(&extCount);
   if (!exts) throw Error("no Vulkan surface extension for this display (" + glfwErrorText + "); use `nusselt render`");
 
-  m_scene = loadSceneOrDefault(a.scene, a.camera);
-  printSceneWarnings(m_scene, a.quiet);
-  applyEnvironmentOptions(m_scene, a.env, a.quiet);
+  m_scene = loadCommandScene(a.scene, a.camera, a.env, a.quiet);
   m_settings.seed = a.seed;
   m_settings.maxDepth = a.maxDepth;
   parseLighting(a.lighting, m_settings.lighting);
