@@ -27,6 +27,7 @@
 #include "render/renderer.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
+#include "util/format.h"
 #include "util/progress.h"
 #include "util/stop_signal.h"
 #include "vk/vk.h"
@@ -139,9 +140,6 @@ int renderCommand(const RenderArgs& a) {
   if (s.integrator == IntegratorKind::Vegas) {
     if (s.guiding) throw Error("--integrator vegas with --guiding on: not supported (docs/vegas.md)");
   }
-  if (s.guiding && !a.resume.empty())
-    throw Error("--resume with --guiding on: a guided render cannot be resumed yet (its guide is not in the file; "
-                "issue 16)");
   imageSize(scene, a.width, a.height, 512u, s.width, s.height);
   // The samples to take: --spp, or without it and with --time as many as the budget allows.
   const std::uint32_t targetSpp = a.timeBudget > 0 && !a.sppGiven ? (1u << 30) : a.spp;
@@ -171,6 +169,27 @@ int renderCommand(const RenderArgs& a) {
     if (!d.empty())
       throw Error("--resume " + a.resume + ": " + d + " (saved vs this render; a render can only be resumed with the "
                   "same scene and settings)");
+    // A guided render resumes with the guide it had learned: the same guide settings (the training
+    // spp as recorded: the default depends on --spp) and the guide trained again below.
+    if (s.guiding) {
+      const RenderSettings& p = previous.settings;
+      auto refuse = [&](const std::string& what, const std::string& was, const std::string& is) {
+        throw Error("--resume " + a.resume + ": " + what + " was " + was + ", this render has " + is +
+                    " (a guided render resumes with the guide settings it was rendered with)");
+      };
+      if (a.guideTrain != 0 && a.guideTrain != p.guideTrainSpp)
+        refuse("--guide-train", std::to_string(p.guideTrainSpp), std::to_string(a.guideTrain));
+      if (p.guideAlpha != s.guideAlpha)
+        refuse("--guide-alpha", p.guideAlpha < 0 ? "auto" : formatNumber(p.guideAlpha),
+               s.guideAlpha < 0 ? "auto" : formatNumber(s.guideAlpha));
+      if (p.guideSpatialThreshold != s.guideSpatialThreshold)
+        refuse("--guide-spatial", formatNumber(p.guideSpatialThreshold), formatNumber(s.guideSpatialThreshold));
+      if (p.guideMemory != s.guideMemory)
+        refuse("--guide-memory", formatNumber(p.guideMemory / 1048576.0) + " MiB",
+               formatNumber(s.guideMemory / 1048576.0) + " MiB");
+      s.guideTrainSpp = p.guideTrainSpp;
+      base.settings.guideTrainSpp = p.guideTrainSpp;
+    }
     if (previous.settings.sampleOffset != s.sampleOffset)
       throw Error("--resume " + a.resume + ": --spp-offset was " + std::to_string(previous.settings.sampleOffset) +
                   ", this render has " + std::to_string(s.sampleOffset));
@@ -210,8 +229,6 @@ int renderCommand(const RenderArgs& a) {
                              "uninterrupted render)\n",
                      a.resume.c_str(), traversalName(previous.settings.traversal),
                      traversalName(renderer.settings().traversal));
-      renderer.restoreAccumulation(saved, previous.spp);
-      renderer.addStats(previous.stats);
     }
     if (!a.quiet) {
       char structures[128];
@@ -243,6 +260,23 @@ int renderCommand(const RenderArgs& a) {
                    integratorName(s.integrator), s.guiding ? (", guiding on (" + std::to_string(sum.guideTrainSpp) + " training spp)").c_str() : "");
     }
 
+    if (!a.resume.empty()) {
+      if (renderer.guide()) {
+        // The guide is not in the file: training is deterministic, so the same samples train the
+        // same guide again; its hash in the file says whether it did.
+        if (!a.quiet)
+          std::fprintf(stderr, "guiding: training the guide again on the first %u spp of %s\n",
+                       std::min(previous.spp, renderer.summary().guideTrainSpp), a.resume.c_str());
+        renderer.retrainGuide(previous.spp);
+        const std::string hash = renderer.guide()->hashText();
+        if (previous.guideHash != hash && !a.quiet)
+          std::fprintf(stderr, "warning: %s: the guide trained again (hash %s) differs from the one the render had "
+                               "(%s); the render continues unbiased but is not bit-identical to an uninterrupted one\n",
+                       a.resume.c_str(), hash.c_str(), previous.guideHash.empty() ? "not recorded" : previous.guideHash.c_str());
+      }
+      renderer.restoreAccumulation(saved, previous.spp);
+      renderer.addStats(previous.stats);
+    }
     base.totalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();  // set-up
     RenderLoopOptions lo;
     lo.spp = targetSpp;

@@ -2,6 +2,7 @@
 #include "render/guide.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 
 #include "../../shaders/shared/layout.h"
@@ -18,6 +19,12 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
 // The directional nodes start at this byte offset of the arrays buffer, after at most this many
 // spatial nodes' bytes: the spatial array never exceeds the cap either, so both fit in cap + 32.
 std::uint64_t arraysBytes(std::uint64_t cap) { return cap + sizeof(shared::GuideDirNode); }
+// FNV-1a, 64 bits, continued from h over n bytes.
+std::uint64_t fnv1a(std::uint64_t h, const void* data, std::size_t n) {
+  const auto* b = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 0x100000001b3ull;
+  return h;
+}
 constexpr std::uint64_t kRecordBytes = GUIDE_RECORD_VEC4S * sizeof(glm::vec4);
 }  // namespace
 
@@ -47,6 +54,12 @@ DeviceGuide::~DeviceGuide() {
 
 std::uint64_t DeviceGuide::deviceBytes() const { return m_info.size + m_arrays.size + m_records.size; }
 
+std::string DeviceGuide::hashText() const {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(m_hash));
+  return text;
+}
+
 void DeviceGuide::fillGlobals(shared::Globals& g) const { g.guide = m_info.address; }
 
 void DeviceGuide::upload() {
@@ -61,6 +74,7 @@ void DeviceGuide::upload() {
   auto* base = static_cast<unsigned char*>(m_arrays.mapped);
   std::memcpy(base, spatial.data(), spatialBytes);
   std::memcpy(base + dirOffset, dir.data(), dir.size() * sizeof(dir[0]));
+  m_hash = fnv1a(fnv1a(0xcbf29ce484222325ull, spatial.data(), spatialBytes), dir.data(), dir.size() * sizeof(dir[0]));
   GpuGuide info{};
   const glm::vec3 lo = m_tree.boundsMin(), hi = m_tree.boundsMax();
   info.boundsMin = shared::vec4(lo, 0.0f);

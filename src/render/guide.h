@@ -6,6 +6,7 @@
 #pragma once
 #include <chrono>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "guiding/guide_tree.h"
@@ -49,6 +50,11 @@ class DeviceGuide {
   double trainingSeconds() const { return m_seconds; }  // CPU time of downloads, splats, refinement
   std::uint64_t deviceBytes() const;
   const guiding::GuideTree& tree() const { return m_tree; }
+  // A 64-bit FNV-1a hash of the arrays the shade stages sample from (spatial and directional
+  // nodes, the regions' alphas with them), as last uploaded: the render record states it, and a
+  // resumed render, which trains its guide again, checks that it learned the same one.
+  std::uint64_t hash() const { return m_hash; }
+  std::string hashText() const;  // hash() as 16 hex digits (the record's nusselt/guideHash)
 
  private:
   void upload();
@@ -64,6 +70,7 @@ class DeviceGuide {
   std::vector<glm::vec4> m_hostRecords, m_hostRadiance;
   std::vector<guiding::IterationReport> m_reports;
   double m_seconds = 0;
+  std::uint64_t m_hash = 0;
 };
 
 }  // namespace nusselt

@@ -362,4 +362,10 @@ void PathIntegrator::foldStats() {
 
 void PathIntegrator::addStats(const RenderStats& c) { m_totals.add(c); }
 
+void PathIntegrator::clearCounters() {
+  m_totals = RenderStats{};
+  std::fill(m_raysPerBounce.begin(), m_raysPerBounce.end(), 0);
+  m_stageSeconds.clear();
+}
+
 }  // namespace nusselt

@@ -69,6 +69,9 @@ class PathIntegrator : public Integrator {
   void foldStats();
   RenderStats stats() const override { return m_totals; }
   void addStats(const RenderStats& carried) override;
+  // Forgets the counters, rays per bounce and stage times of the passes so far (a resumed guided
+  // render's retraining passes, Renderer::retrainGuide).
+  void clearCounters();
   const std::vector<std::pair<std::string, double>>& stageSeconds() const override { return m_stageSeconds; }
   std::uint64_t deviceBytes() const override;
   const std::vector<std::uint64_t>& raysPerBounce() const override { return m_raysPerBounce; }

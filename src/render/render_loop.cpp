@@ -4,6 +4,7 @@
 #include <csignal>
 #include <cstdio>
 
+#include "render/guide.h"
 #include "render/mlt_integrator.h"
 #include "util/error.h"
 #include "util/progress.h"
@@ -87,6 +88,7 @@ RenderRecord RenderLoop::record(bool checkpoint) const {
   r.renderSeconds = m_previous.renderSeconds + seconds();
   r.totalSeconds = m_previous.totalSeconds + secondsSince(m_start) + m_base.totalSeconds;
   r.timeBudget = m_options.timeBudget;
+  if (const DeviceGuide* guide = m_renderer.guide()) r.guideHash = guide->hashText();
   return r;
 }
 

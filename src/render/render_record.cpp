@@ -6,6 +6,7 @@
 
 #include "render/environment.h"
 #include "util/error.h"
+#include "util/format.h"
 
 namespace nusselt {
 
@@ -39,13 +40,6 @@ bool parseCamera(const std::string& text, Camera& c) {
 
 }  // namespace
 
-namespace {
-std::string number(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-}  // namespace
 
 std::string describeEnvironment(const Scene& scene) {
   const Environment e = effectiveEnvironment(scene);
@@ -111,6 +105,7 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
       meta.doubles.push_back({"nusselt/guideAlpha", r.settings.guideAlpha});
     meta.doubles.push_back({"nusselt/guideSpatial", r.settings.guideSpatialThreshold});
     meta.doubles.push_back({"nusselt/guideMemory", double(r.settings.guideMemory)});
+    if (!r.guideHash.empty()) meta.strings.push_back({"nusselt/guideHash", r.guideHash});
   }
   // The integrator's name (written only when it is not the path tracer: path headers are as
   // before); "nusselt/integrator" describes it.
@@ -224,6 +219,7 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
                               : static_cast<float>(findDouble(meta, "nusselt/guideAlpha").value_or(0.5));
   r.settings.guideSpatialThreshold = findDouble(meta, "nusselt/guideSpatial").value_or(12000);
   r.settings.guideMemory = static_cast<std::uint64_t>(findDouble(meta, "nusselt/guideMemory").value_or(16 << 20));
+  r.guideHash = findString(meta, "nusselt/guideHash").value_or("");
   return r;
 }
 
@@ -247,8 +243,8 @@ std::string firstDifference(const RenderRecord& a, const RenderRecord& b) {
         differ("the roulette (--roulette)", rouletteModeName(s.roulette), rouletteModeName(t.roulette)),
         differ("the camera", cameraText(a.camera), cameraText(b.camera)),
         differ("the environment (--env, --env-color)", a.environment, b.environment),
-        differ("the environment scale (--env-scale)", number(a.envScale), number(b.envScale)),
-        differ("the environment rotation (--env-rotate)", number(a.envRotate), number(b.envRotate)),
+        differ("the environment scale (--env-scale)", formatNumber(a.envScale), formatNumber(b.envScale)),
+        differ("the environment rotation (--env-rotate)", formatNumber(a.envRotate), formatNumber(b.envRotate)),
         differ("the environment's selection (--env-select)", a.envSelect, b.envSelect),
         differ("path guiding (--guiding)", s.guiding ? "on" : "off", t.guiding ? "on" : "off")})
     if (!d.empty()) return d;

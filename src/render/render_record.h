@@ -33,6 +33,9 @@ struct RenderRecord {
   std::string environment = "none";
   double envScale = 1, envRotate = 0;
   std::string envSelect = "half";  // --env-select
+  // Path guiding: the hash of the guide the render sampled from when it was written
+  // (DeviceGuide::hash, 16 hex digits); empty for unguided renders and older files.
+  std::string guideHash;
 };
 
 // The record's description of an environment ("none", "uniform R,G,B", "map FILE"); a scene's

@@ -256,6 +256,18 @@ void Renderer::restoreAccumulation(const Image& saved, std::uint32_t spp) {
   m_samples = spp;
 }
 
+std::uint32_t Renderer::retrainGuide(std::uint32_t spp) {
+  if (!m_guide) return 0;
+  const std::uint32_t until = std::min(spp, guideTrainingSpp(m_settings));
+  // renderPass(until - done) asks for what the render loop asked for (the rest of its target),
+  // which the training iterations and samplesPerPass cut into the same passes.
+  while (m_samples < until) renderPass(until - m_samples);
+  m_film->clear();
+  m_samples = 0;
+  m_paths->clearCounters();
+  return until;
+}
+
 void Renderer::writeCamera(const Camera& cam) {
   Globals& g = m_globals->host();
   glm::vec3 f = glm::normalize(cam.forward);

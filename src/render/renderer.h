@@ -81,6 +81,12 @@ class Renderer {
   // settings): the next pass traces sample index sampleOffset + spp, so a resumed render equals
   // an uninterrupted one bit for bit. Throws nusselt::Error when the image does not fit.
   void restoreAccumulation(const Image& saved, std::uint32_t spp);
+  // Path guiding, before restoreAccumulation of a guided render saved at `spp` samples: trains the
+  // guide again on samples 0 .. min(spp, training spp) - 1, in the passes the saved render traced
+  // them in, so the guide equals the one the saved render had learned (training is deterministic:
+  // docs/guiding.md, "Resume"). The film and the statistics of these passes are discarded.
+  // Returns the samples traced (0 for unguided renders).
+  std::uint32_t retrainGuide(std::uint32_t spp);
   // Adds counts carried over from a resumed render to the statistics.
   void addStats(const RenderStats& carried) { m_integrator->addStats(carried); }
   RenderStats stats() const { return m_integrator->stats(); }

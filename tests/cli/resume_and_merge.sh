@@ -49,6 +49,29 @@ else
   fail "interrupted render wrote no spp"
 fi
 
+# A guided render (docs/guiding.md, "Resume") resumes bit-exactly too: the resumed run trains its
+# guide again on the saved render's first samples and checks the guide's hash in the header. Saved
+# inside training at an iteration's end (3 spp), inside an iteration (5), and after training (9).
+# A fixed --guide-alpha makes the guide sample everywhere (auto may leave it unused here).
+guided=(--guiding on --guide-train 7 --guide-alpha 0.5)
+"$nusselt" render "${common[@]}" "${guided[@]}" --spp 12 -o "$work/gfull.exr" || fail "guided render"
+for k in 3 5 9; do
+  "$nusselt" render "${common[@]}" "${guided[@]}" --spp $k -o "$work/g$k.exr" || fail "guided render of $k spp"
+  "$nusselt" render --width 24 --height 16 --seed 3 --max-depth 4 "${guided[@]}" --spp 12 --resume "$work/g$k.exr" \
+    2>"$work/err" || fail "guided resume from $k spp: $(cat "$work/err")"
+  grep -q "warning" "$work/err" && fail "guided resume from $k spp warns: $(grep warning "$work/err")"
+  [ "$(maxdiff "$work/g$k.exr" "$work/gfull.exr")" = 0 ] && echo "ok   guided, resumed $k -> 12 spp equals 12 spp bit for bit" ||
+    fail "guided resume from $k spp differs: $("$nusselt" diff "$work/g$k.exr" "$work/gfull.exr")"
+done
+# Its guide settings must be the saved render's.
+"$nusselt" render "${common[@]}" "${guided[@]}" --spp 3 -o "$work/g3.exr" || fail "guided render of 3 spp"
+if "$nusselt" render "${common[@]}" --guiding on --guide-train 7 --guide-alpha 0.25 --spp 12 --resume "$work/g3.exr" 2>"$work/err"; then
+  fail "guided resume with another --guide-alpha accepted"
+else
+  grep -q -- "--guide-alpha was 0.5" "$work/err" && echo "ok   guided resume with another --guide-alpha refused: $(cat "$work/err")" ||
+    fail "guided resume refusal: $(cat "$work/err")"
+fi
+
 # Split across two jobs by --spp-offset, merged: the single 6-spp render up to float rounding
 # of the sums (the parts add their sums in another order).
 "$nusselt" render "${common[@]}" --spp 3 --spp-offset 0 -o "$work/a.exr" || fail "job a"
