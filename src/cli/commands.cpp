@@ -187,8 +187,8 @@ int renderCommand(const RenderArgs& a) {
       if (p.guideMemory != s.guideMemory)
         refuse("--guide-memory", formatNumber(p.guideMemory / 1048576.0) + " MiB",
                formatNumber(s.guideMemory / 1048576.0) + " MiB");
-      s.guideTrainSpp = p.guideTrainSpp;
-      base.settings.guideTrainSpp = p.guideTrainSpp;
+      s.guideTrainSpp = base.settings.guideTrainSpp = p.guideTrainSpp;
+      s.guideTrainPass = base.settings.guideTrainPass = p.guideTrainPass;  // the passes it trained in
     }
     if (previous.settings.sampleOffset != s.sampleOffset)
       throw Error("--resume " + a.resume + ": --spp-offset was " + std::to_string(previous.settings.sampleOffset) +

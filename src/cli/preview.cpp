@@ -59,11 +59,17 @@ const char* const kKeysHelp =
     "                                   uniform\n"
     "  Tab                              next available sampling strategy\n"
     "  L                                lighting estimator: mis -> nee -> bsdf\n"
+    "  G                                path guiding on/off (trains on the first 127 spp; camera\n"
+    "                                   and lighting changes keep the guide)\n"
     "  Space                            pause/resume accumulation\n"
     "  S                                save the accumulation: preview-<n>.exr and preview-<n>.png\n"
     "  H                                print these keys\n"
     "  Esc, Q, closing the window       quit\n"
     "The title bar shows spp, samples/s, sampler, lighting, exposure and the device.";
+
+// Path guiding's training in the preview: 127 spp (iterations of 1, 2, ..., 64), as for renders
+// limited by time (guideTrainingSpp).
+constexpr std::uint32_t kPreviewGuideTrainSpp = 127;
 
 // The sampling strategies the keys 1-5 name; a key switches RenderSettings::sampler (the shade
 // stages are specialised per strategy, so the renderer is recreated).
@@ -88,6 +94,7 @@ struct PreviewArgs {
   std::string sampler = "quadtree";
   std::string tonemap = "clamp";
   std::string traversal = "auto";
+  std::string guiding = "off";
   int device = -1;
   float exposure = 0.0f;
   std::uint32_t frames = 0;   // 0: until closed
@@ -355,6 +362,12 @@ void Preview::onKey(int key, int mods) {
       updateTitle(true);
       return;
     }
+    case GLFW_KEY_G:
+      m_settings.guiding = !m_settings.guiding;
+      m_samplerDirty = true;  // the shade stages are specialised with GUIDING: a new Renderer
+      std::fprintf(stderr, "guiding: %s\n", m_settings.guiding ? "on" : "off");
+      updateTitle(true);
+      return;
     case GLFW_KEY_SPACE: m_paused = !m_paused; updateTitle(true); return;
     case GLFW_KEY_S: save(); return;
     case GLFW_KEY_H: std::fprintf(stderr, "%s\n", kKeysHelp); return;
@@ -591,11 +604,15 @@ void Preview::updateTitle(bool force) {
   auto now = std::chrono::steady_clock::now();
   if (!force && now - m_lastTitle < std::chrono::milliseconds(250)) return;
   m_lastTitle = now;
+  char guide[64] = "";
+  if (m_settings.guiding)
+    std::snprintf(guide, sizeof guide, " | guiding (trained %u/%u spp)", m_renderer ? m_renderer->guideTrainedSpp() : 0u,
+                  kPreviewGuideTrainSpp);
   char title[512];
   std::snprintf(title, sizeof title,
-                "nusselt preview | %u spp | %.3g Msamples/s | sampler %s | lighting %s | exposure %+.1f (%s)%s | %ux%u | %s",
+                "nusselt preview | %u spp | %.3g Msamples/s | sampler %s | lighting %s%s | exposure %+.1f (%s)%s | %ux%u | %s",
                 m_renderer ? m_renderer->samplesDone() : 0u, m_samplesPerSecond / 1e6, samplerName(m_settings.sampler),
-                lightingModeName(m_settings.lighting), m_exposure, m_reinhard ? "Reinhard" : "clamp",
+                lightingModeName(m_settings.lighting), guide, m_exposure, m_reinhard ? "Reinhard" : "clamp",
                 m_paused ? " | paused" : (m_args.maxSpp && m_renderer && m_renderer->samplesDone() >= m_args.maxSpp ? " | done" : ""),
                 m_settings.width, m_settings.height, m_ctx.deviceName.c_str());
   glfwSetWindowTitle(m_window, title);
@@ -683,6 +700,9 @@ int Preview::run() {
   parseSampler(a.sampler, m_settings.sampler);
   parseTraversal(a.traversal, m_settings.traversal);
   m_settings.spp = 1;
+  // Path guiding (G switches): the open-ended render's training, as `render --time` has it.
+  m_settings.guiding = a.guiding == "on";
+  m_settings.guideTrainSpp = kPreviewGuideTrainSpp;
   m_exposure = a.exposure;
   m_reinhard = a.tonemap == "reinhard";
   std::uint32_t imageWidth = 0, imageHeight = 0;
@@ -896,6 +916,8 @@ void registerPreviewCommand(CLI::App& app, CommandRunner& run) {
       ->capture_default_str()->check(CLI::IsMember(enumNames(kSamplerNames)));
   p->add_option("--lighting", a->lighting, "Light transport estimator at start (L switches): mis, nee, bsdf")
       ->capture_default_str()->check(CLI::IsMember(enumNames(kLightingNames)));
+  p->add_option("--guiding", a->guiding, "Path guiding at start (G switches): off, on (trains on the first 127 spp; docs/guiding.md)")
+      ->capture_default_str()->check(CLI::IsMember({"off", "on"}));
   p->add_option("--exposure", a->exposure, "Display exposure in stops ([ and ] change it)")->capture_default_str();
   p->add_option("--tonemap", a->tonemap, "Display tone map at start (T switches): clamp (as `render --png`), reinhard")
       ->capture_default_str()->check(CLI::IsMember({"clamp", "reinhard"}));

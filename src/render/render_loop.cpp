@@ -25,6 +25,7 @@ RenderLoop::RenderLoop(Renderer& renderer, RenderRecord base, const RenderRecord
   m_start = m_lastCheckpoint = std::chrono::steady_clock::now();
   // The record names the traversal that ran (the renderer resolved auto).
   m_base.settings.traversal = m_renderer.settings().traversal;
+  m_base.settings.guideTrainPass = m_renderer.settings().guideTrainPass;  // resolved by the renderer too
   if (m_options.progress) {
     const RenderSettings& s = m_renderer.settings();
     // Paths per spp: one per pixel, or one mutation per chain for Metropolis (docs/mlt.md).

@@ -98,6 +98,7 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
   if (r.settings.guiding) {
     meta.strings.push_back({"nusselt/guiding", "on"});
     meta.ints.push_back({"nusselt/guideTrainSpp", guideTrainingSpp(r.settings)});
+    meta.ints.push_back({"nusselt/guideTrainPass", r.settings.guideTrainPass});
     // The selection probability: "auto" (learned per region) as a string, a fixed one as before.
     if (r.settings.guideAlpha < 0)
       meta.strings.push_back({"nusselt/guideAlpha", "auto"});
@@ -213,6 +214,8 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   // Absent in unguided renders (and files written before guiding existed).
   r.settings.guiding = findString(meta, "nusselt/guiding").value_or("off") == "on";
   r.settings.guideTrainSpp = static_cast<std::uint32_t>(findInt(meta, "nusselt/guideTrainSpp").value_or(0));
+  // Absent in files written before it: 0, the resuming render's own samples per pass.
+  r.settings.guideTrainPass = static_cast<std::uint32_t>(findInt(meta, "nusselt/guideTrainPass").value_or(0));
   // Files written before "auto" existed used a fixed alpha (0.5 by default).
   r.settings.guideAlpha = findString(meta, "nusselt/guideAlpha").value_or("") == "auto"
                               ? -1.0f

@@ -170,6 +170,7 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   writeCamera(m_camera);
 
   if (settings.guiding) {
+    if (m_settings.guideTrainPass == 0) m_settings.guideTrainPass = m_samplesPerPass;
     // The guide's root box: the scene's bounds.
     glm::vec3 lo(0.0f), hi(0.0f);
     if (!scene.positions.empty()) lo = hi = scene.positions[0];
@@ -232,19 +233,22 @@ void Renderer::renderPass(std::uint32_t samples) {
   if (fault && m_samples >= std::strtoul(fault, nullptr, 10)) VK_CHECK(VK_ERROR_DEVICE_LOST);
   samples = samples == 0 ? m_samplesPerPass : std::min(samples, m_samplesPerPass);
   // Path guiding's training: iteration k covers samples [2^k - 1, 2^(k+1) - 1) of the first
-  // guideTrainingSpp; a pass never crosses an iteration's end, where the guide is refined.
+  // guideTrainingSpp the guide has seen (m_guideSamples: the film's samples, except that a reset
+  // (a preview's camera or lighting change) keeps the guide and its count); a pass never crosses
+  // an iteration's end, where the guide is refined.
   const std::uint32_t trainSpp = m_guide ? guideTrainingSpp(m_settings) : 0;
-  const bool training = m_samples < trainSpp;
+  const bool training = m_guideSamples < trainSpp;
   std::uint32_t iteration = 0, iterationEnd = 0;
   if (training) {
-    while ((2u << iteration) - 1 <= m_samples) ++iteration;
+    while ((2u << iteration) - 1 <= m_guideSamples) ++iteration;
     iterationEnd = std::min((2u << iteration) - 1, trainSpp);
-    samples = std::min(samples, iterationEnd - m_samples);
+    samples = std::min({samples, iterationEnd - m_guideSamples, m_settings.guideTrainPass});
   }
   if (m_guide) m_guide->setRecording(training);
   m_integrator->renderPass(m_settings.sampleOffset + m_samples, samples);
   m_samples += samples;
-  if (training && m_samples == iterationEnd) m_guide->endIteration(iteration);
+  m_guideSamples += samples;
+  if (training && m_guideSamples == iterationEnd) m_guide->endIteration(iteration);
 }
 
 void Renderer::render(std::uint32_t spp) {
@@ -253,7 +257,7 @@ void Renderer::render(std::uint32_t spp) {
 
 void Renderer::restoreAccumulation(const Image& saved, std::uint32_t spp) {
   m_film->restore(saved, spp);
-  m_samples = spp;
+  m_samples = m_guideSamples = spp;
 }
 
 std::uint32_t Renderer::retrainGuide(std::uint32_t spp) {
@@ -261,7 +265,7 @@ std::uint32_t Renderer::retrainGuide(std::uint32_t spp) {
   const std::uint32_t until = std::min(spp, guideTrainingSpp(m_settings));
   // renderPass(until - done) asks for what the render loop asked for (the rest of its target),
   // which the training iterations and samplesPerPass cut into the same passes.
-  while (m_samples < until) renderPass(until - m_samples);
+  while (m_guideSamples < until) renderPass(until - m_guideSamples);
   m_film->clear();
   m_samples = 0;
   m_paths->clearCounters();

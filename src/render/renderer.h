@@ -98,6 +98,11 @@ class Renderer {
   const SceneSummary& summary() const { return m_summary; }
   // Path guiding's state (null for unguided renders): its training reports and times.
   const DeviceGuide* guide() const { return m_guide.get(); }
+  // Path guiding: the samples per pixel the guide has trained on so far (at most the training
+  // spp), across resets; 0 for unguided renders.
+  std::uint32_t guideTrainedSpp() const {
+    return m_guide ? std::min(m_guideSamples, guideTrainingSpp(m_settings)) : 0;
+  }
   const RenderSettings& settings() const { return m_settings; }
   // The path tracer that traces this render's paths (tests read and write its path state).
   PathIntegrator& paths() { return *m_paths; }
@@ -129,6 +134,7 @@ class Renderer {
   RenderSettings m_settings;
   SceneSummary m_summary;
   std::uint32_t m_samples = 0;
+  std::uint32_t m_guideSamples = 0;  // samples the guide has seen (renderPass): not reset by reset()
   std::uint32_t m_samplesPerPass = 1;
   Camera m_camera;
   std::unique_ptr<StageGlobals> m_globals;

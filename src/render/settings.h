@@ -154,6 +154,10 @@ struct RenderSettings {
   // Samples per pixel of the guide's training, in iterations of 1, 2, 4, ... (`--guide-train`);
   // 0 = automatic (guideTrainingSpp). Training samples are rendered and kept in the image.
   std::uint32_t guideTrainSpp = 0;
+  // Samples per pixel of a training pass at most (0: the render's samples per pass; the renderer
+  // resolves it and the record states it). The guide depends on how its training samples were
+  // grouped into passes (their splat order), so a resumed render trains in the saved one's passes.
+  std::uint32_t guideTrainPass = 0;
   // The guide's trees at most this many bytes on the device (`--guide-memory`, MiB there).
   std::uint64_t guideMemory = 16ull << 20;
   // The guide's selection probability (`--guide-alpha`): < 0 (`auto`, the default) learns it per

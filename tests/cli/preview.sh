@@ -266,5 +266,26 @@ grep -q "sampler: analytic" "$work/keys.out" || fail "key 3 did not switch to th
   ok "a moved view resumes at its own camera (= 8 spp of the moved preview)" ||
   fail "moved view resumed: $("$nusselt" diff "$work/pmoved.exr" "$work/pmoved8.exr")"
 
+# ---- Path guiding: a guided preview (training passes of 1 spp, 127 training spp) accumulates the
+# film of the guided headless render with those settings, its save resumes bit for bit (the guide
+# trained again, its hash checked), and G switches guiding on --------------------------------------
+"$nusselt" preview --width $W --height $H --frames 100 --max-spp 8 --guiding on --exr "$work/pguided.exr" -q ||
+  fail "guided preview exit $?"
+gr=(--width $W --height $H --guiding on --guide-train 127 --samples-per-pass 1 -q)
+"$nusselt" render "${gr[@]}" --spp 8 -o "$work/rguided8.exr" || fail "guided render --spp 8 exit $?"
+"$nusselt" diff "$work/pguided.exr" "$work/rguided8.exr" | grep -q "max |diff| 0$" &&
+  ok "guided preview (8 frames) = guided headless render of 8 spp in 1-spp passes, bit for bit" ||
+  fail "guided preview vs render: $("$nusselt" diff "$work/pguided.exr" "$work/rguided8.exr")"
+"$nusselt" render --width $W --height $H --guiding on --spp 12 --resume "$work/pguided.exr" 2>"$work/gres.err" ||
+  fail "render --resume of a guided preview save: $(cat "$work/gres.err")"
+"$nusselt" render "${gr[@]}" --spp 12 -o "$work/rguided12.exr" || fail "guided render --spp 12 exit $?"
+! grep -q warning "$work/gres.err" && "$nusselt" diff "$work/pguided.exr" "$work/rguided12.exr" | grep -q "max |diff| 0$" &&
+  ok "guided preview save resumed to 12 spp = guided headless 12 spp, bit for bit" ||
+  fail "guided preview save resumed: $(cat "$work/gres.err") $("$nusselt" diff "$work/pguided.exr" "$work/rguided12.exr")"
+"$nusselt" preview --width $W --height $H --frames 100 --max-spp 4 --test-keys G --exr "$work/pg.exr" >"$work/pg.out" 2>&1 ||
+  fail "preview with G exit $?: $(tail -3 "$work/pg.out")"
+grep -q "guiding: on" "$work/pg.out" && "$nusselt" info "$work/pg.exr" | grep -q "nusselt/guiding: on" &&
+  ok "G switches guiding on (the saved film is a guided render's)" || fail "G: $(cat "$work/pg.out")"
+
 [ $fails -eq 0 ] && echo "preview checks pass"
 exit $((fails > 0))
