@@ -18,6 +18,10 @@
 // MIS estimate under each candidate alpha of kAlphaCandidates, estimated from the samples drawn
 // with the alpha the iteration used, and the guide is used (alpha = the best candidate) only
 // where it lowers that moment significantly against alpha = 0 (BRDF sampling alone).
+// The splats are box-filtered (settings dirFilter, on by default: shared among the directional
+// cells a box of the landing cell's size overlaps; spatialFilter, off: among the regions a box of
+// the vertex's region's size overlaps), and flatten can mix a uniform density into every trained
+// guide (settings floor, 0 by default). docs/guiding.md, "Splat filtering".
 // Everything runs in a fixed order: the same splats give the same trees, bit for bit.
 #pragma once
 #include <array>
