@@ -69,6 +69,9 @@ struct RenderArgs {
   double guideMemoryMiB = 16;
   double guideSpatial = 12000;
   std::string guideAlpha = "auto";
+  std::string guideFilter = "box";
+  std::string guideSpatialFilter = "none";
+  double guideFloor = 0.0;
   bool variance = false;
   bool validation = false;
   bool quiet = false;
@@ -128,6 +131,9 @@ int renderCommand(const RenderArgs& a) {
   s.guideSpatialThreshold = a.guideSpatial;
   s.guideAlpha = parseGuideAlpha(a.guideAlpha, 0.99f);
   s.guideMemory = static_cast<std::uint64_t>(a.guideMemoryMiB * 1048576.0);
+  s.guideDirFilter = a.guideFilter == "box";
+  s.guideSpatialFilter = a.guideSpatialFilter == "box";
+  s.guideFloor = a.guideFloor;
   // What Metropolis renders do not support (docs/mlt.md): guiding and the variance of a correlated
   // estimate. A resumed one restarts its chains from a new bootstrap (docs/mlt.md, "Resume").
   if (s.integrator == IntegratorKind::Mlt) {
@@ -840,6 +846,18 @@ int runCli(int argc, char** argv) {
                                                      "guide, where it does not lower the variance), or a number in "
                                                      "[0, 0.99] for every region that learned something")
       ->capture_default_str();
+  render->add_option("--guide-filter", ra.guideFilter, "The guide's directional splat filter: box = each training "
+                                                       "splat shared among the cells a box of its cell's size "
+                                                       "overlaps, none = the one cell it lands in (docs/guiding.md)")
+      ->capture_default_str()->check(CLI::IsMember({"box", "none"}));
+  render->add_option("--guide-spatial-filter", ra.guideSpatialFilter, "The guide's spatial splat filter: box = each "
+                                                                      "training splat shared among the regions a box "
+                                                                      "of its region's size overlaps, none = its own "
+                                                                      "region")
+      ->capture_default_str()->check(CLI::IsMember({"box", "none"}));
+  render->add_option("--guide-floor", ra.guideFloor, "Weight of the uniform sphere density mixed into the learned "
+                                                     "guide (0: none)")
+      ->capture_default_str()->check(CLI::Range(0.0, 0.5));
   render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
   render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
   render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");

@@ -47,6 +47,9 @@ struct GuideViewArgs {
   std::uint32_t size = 256;
   double guideSpatial = 12000;
   double guideMemoryMiB = 16;
+  std::string guideFilter = "box";
+  std::string guideSpatialFilter = "none";
+  double guideFloor = 0.0;
   int device = -1;
   bool quiet = false;
   EnvironmentArgs env;
@@ -120,6 +123,9 @@ int guideViewCommand(const GuideViewArgs& a) {
   s.guideTrainSpp = a.train;
   s.guideSpatialThreshold = a.guideSpatial;
   s.guideMemory = static_cast<std::uint64_t>(a.guideMemoryMiB * 1048576.0);
+  s.guideDirFilter = a.guideFilter == "box";
+  s.guideSpatialFilter = a.guideSpatialFilter == "box";
+  s.guideFloor = a.guideFloor;
   s.spp = a.train;
 
   // The pixel's first hit, with the camera the render uses.
@@ -277,6 +283,13 @@ void registerGuideViewCommand(CLI::App& app, CommandRunner& run) {
       ->capture_default_str()->check(CLI::Range(1.0, 1e12));
   c->add_option("--guide-memory", a->guideMemoryMiB, "Memory cap of the guide's trees, MiB")
       ->capture_default_str()->check(CLI::Range(0.01, 4096.0));
+  c->add_option("--guide-filter", a->guideFilter, "The training splats' directional filter (as render --guide-filter)")
+      ->capture_default_str()->check(CLI::IsMember({"box", "none"}));
+  c->add_option("--guide-spatial-filter", a->guideSpatialFilter,
+                "The training splats' spatial filter (as render --guide-spatial-filter)")
+      ->capture_default_str()->check(CLI::IsMember({"box", "none"}));
+  c->add_option("--guide-floor", a->guideFloor, "Uniform density mixed into the guide (as render --guide-floor)")
+      ->capture_default_str()->check(CLI::Range(0.0, 0.5));
   c->add_option("--size", a->size, "Side of each panel in pixels")->capture_default_str()->check(CLI::Range(16u, 4096u));
   c->add_option("--camera", a->camera, "Use the glTF camera with this name (default: the first camera)");
   c->add_option("--device", a->device, "Vulkan device index (see `nusselt devices`)");

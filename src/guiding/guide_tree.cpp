@@ -34,6 +34,71 @@ void DirTree::splat(glm::vec2 p, double value) {
   }
 }
 
+double DirTree::leafSide(glm::vec2 p) const {
+  std::uint32_t node = 0;
+  float x0 = 0.0f, y0 = 0.0f, size = 1.0f;
+  for (std::uint32_t d = 0; d <= GUIDE_MAX_DIR_DEPTH; ++d) {
+    size *= 0.5f;
+    std::uint32_t c = 0;
+    if (p.x >= x0 + size) {
+      c += 1;
+      x0 += size;
+    }
+    if (p.y >= y0 + size) {
+      c += 2;
+      y0 += size;
+    }
+    if (m_nodes[node].child[c] == 0) break;
+    node = m_nodes[node].child[c];
+  }
+  return size;
+}
+
+void DirTree::splatBox(glm::vec2 p, double side, double value) {
+  if (!(side > 0)) {
+    splat(p, value);
+    return;
+  }
+  const double h = 0.5 * side;
+  // u (cos theta) ends at the poles: the box is cut there and its value renormalised to the rest.
+  const double bx0 = std::max(0.0, double(p.x) - h), bx1 = std::min(1.0, double(p.x) + h);
+  const double width = bx1 - bx0;
+  if (!(width > 0)) {
+    splat(p, value);
+    return;
+  }
+  const double perArea = value / (width * side);
+  // phi wraps around: a box crossing v = 0 or 1 continues on the other side (side <= 1/2).
+  const double by0 = double(p.y) - h, by1 = double(p.y) + h;
+  if (by0 < 0.0) {
+    splatBoxInto(0, 0.0, 0.0, 1.0, bx0, bx1, by0 + 1.0, 1.0, perArea);
+    splatBoxInto(0, 0.0, 0.0, 1.0, bx0, bx1, 0.0, by1, perArea);
+  } else if (by1 > 1.0) {
+    splatBoxInto(0, 0.0, 0.0, 1.0, bx0, bx1, by0, 1.0, perArea);
+    splatBoxInto(0, 0.0, 0.0, 1.0, bx0, bx1, 0.0, by1 - 1.0, perArea);
+  } else {
+    splatBoxInto(0, 0.0, 0.0, 1.0, bx0, bx1, by0, by1, perArea);
+  }
+}
+
+// Adds valuePerArea x (the overlap of the box [bx0, bx1] x [by0, by1] with each child cell of
+// `node`, whose cell is [x0, x0 + size) x [y0, y0 + size)) to the child's energy, and recurses
+// into inner children: the children's overlaps sum to the node's, so every level receives the
+// same total.
+void DirTree::splatBoxInto(std::uint32_t node, double x0, double y0, double size, double bx0, double bx1, double by0,
+                           double by1, double valuePerArea) {
+  const double h = 0.5 * size;
+  for (std::uint32_t c = 0; c < 4; ++c) {
+    const double cx0 = x0 + ((c & 1u) ? h : 0.0), cy0 = y0 + ((c & 2u) ? h : 0.0);
+    const double ox = std::min(bx1, cx0 + h) - std::max(bx0, cx0);
+    const double oy = std::min(by1, cy0 + h) - std::max(by0, cy0);
+    if (!(ox > 0) || !(oy > 0)) continue;
+    m_nodes[node].energy[c] += valuePerArea * ox * oy;
+    const std::uint32_t child = m_nodes[node].child[c];
+    if (child != 0) splatBoxInto(child, cx0, cy0, h, bx0, bx1, by0, by1, valuePerArea);
+  }
+}
+
 double DirTree::total() const {
   const Node& r = m_nodes[0];
   return r.energy[0] + r.energy[1] + r.energy[2] + r.energy[3];
@@ -107,12 +172,14 @@ GuideTree::GuideTree(glm::vec3 lo, glm::vec3 hi, const GuideSettings& settings) 
   m_leaves.push_back(Leaf{});
 }
 
-std::uint32_t GuideTree::findLeaf(glm::vec3 x) const {
+std::uint32_t GuideTree::findLeaf(glm::vec3 x) const { return m_nodes[findNode(x)].leaf; }
+
+std::uint32_t GuideTree::findNode(glm::vec3 x) const {
   glm::vec3 lo = m_lo, hi = m_hi;
   std::uint32_t node = 0;
   for (std::uint32_t d = 0; d < GUIDE_MAX_SPATIAL_DEPTH; ++d) {
     const SpatialNode& n = m_nodes[node];
-    if (n.axis == GUIDE_SPATIAL_LEAF) return n.leaf;
+    if (n.axis == GUIDE_SPATIAL_LEAF) return node;
     const std::uint32_t a = n.axis;
     const float mid = 0.5f * (lo[a] + hi[a]);
     if (x[a] < mid) {
@@ -123,7 +190,7 @@ std::uint32_t GuideTree::findLeaf(glm::vec3 x) const {
       node = n.child + 1;
     }
   }
-  return m_nodes[node].leaf;  // not reached: the builder stays below the bound
+  return node;  // not reached: the builder stays below the bound
 }
 
 void GuideTree::leafBounds(std::uint32_t leaf, glm::vec3& lo, glm::vec3& hi) const {
@@ -136,13 +203,47 @@ void GuideTree::leafBounds(std::uint32_t leaf, glm::vec3& lo, glm::vec3& hi) con
   lo = hi = glm::vec3(0.0f);
 }
 
-void GuideTree::splatLeaf(std::uint32_t leafIndex, glm::vec3 d, double value) {
-  Leaf& leaf = m_leaves[leafIndex];
-  leaf.samples += 1;
+void GuideTree::splatDirection(std::uint32_t leafIndex, glm::vec3 d, double value) {
+  DirTree& t = m_leaves[leafIndex].building;
+  const shared::vec2 q = shared::guideDirectionToSquare(shared::vec3(d.x, d.y, d.z));
+  const glm::vec2 p(q.x, q.y);
+  if (m_settings.dirFilter) t.splatBox(p, t.leafSide(p), value);
+  else t.splat(p, value);
+}
+
+void GuideTree::splatAt(std::uint32_t leafIndex, glm::vec3 x, glm::vec3 d, double value) {
+  m_leaves[leafIndex].samples += 1;
   ++m_splats;
-  if (value > 0 && std::isfinite(value)) {
-    shared::vec2 p = shared::guideDirectionToSquare(shared::vec3(d.x, d.y, d.z));
-    leaf.building.splat(glm::vec2(p.x, p.y), value);
+  if (!(value > 0) || !std::isfinite(value)) return;
+  if (!m_settings.spatialFilter || m_leaves.size() == 1) {
+    splatDirection(leafIndex, d, value);
+    return;
+  }
+  // The box of x's region's size around x, within the root box.
+  const SpatialNode& home = m_nodes[findNode(x)];
+  const glm::dvec3 half = 0.5 * (glm::dvec3(home.hi) - glm::dvec3(home.lo));
+  const glm::dvec3 lo = glm::max(glm::dvec3(x) - half, glm::dvec3(m_lo));
+  const glm::dvec3 hi = glm::min(glm::dvec3(x) + half, glm::dvec3(m_hi));
+  const glm::dvec3 ext = hi - lo;
+  const double volume = ext.x * ext.y * ext.z;
+  if (!(volume > 0)) {  // x outside the root box (rounding): its own region only
+    splatDirection(leafIndex, d, value);
+    return;
+  }
+  // Every leaf the box overlaps gets the share of its overlapped volume (children in order).
+  std::uint32_t stack[GUIDE_MAX_SPATIAL_DEPTH + 2];
+  std::uint32_t top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const SpatialNode& n = m_nodes[stack[--top]];
+    const glm::dvec3 o = glm::min(hi, glm::dvec3(n.hi)) - glm::max(lo, glm::dvec3(n.lo));
+    if (!(o.x > 0) || !(o.y > 0) || !(o.z > 0)) continue;
+    if (n.axis == GUIDE_SPATIAL_LEAF) {
+      splatDirection(n.leaf, d, value * (o.x * o.y * o.z / volume));
+      continue;
+    }
+    stack[top++] = n.child + 1;
+    stack[top++] = n.child;
   }
 }
 
@@ -303,11 +404,21 @@ void GuideTree::flatten(std::vector<shared::GuideSpatialNode>& spatial, std::vec
     const DirTree& t = m_leaves[l].sampling;
     const std::uint32_t offset = static_cast<std::uint32_t>(dir.size());
     roots[l] = offset;
-    for (const DirTree::Node& n : t.nodes()) {
+    // The floor: each cell's mass (1 - floor) x its energy + floor x the total x its area, so
+    // that the density the descent samples and guideSquarePdf reads is (1 - floor) x the tree's
+    // + floor (uniform over the map, hence over the sphere). The nodes' children follow their
+    // parent in the array: a cell's area is known when its node is reached.
+    const double total = t.total();
+    const double fl = total > 0 ? std::clamp(m_settings.floor, 0.0, 1.0) : 0.0;
+    std::vector<double> childArea(t.nodeCount(), 0.25);
+    for (std::size_t i = 0; i < t.nodes().size(); ++i) {
+      const DirTree::Node& n = t.nodes()[i];
       shared::GuideDirNode g{};
       for (int c = 0; c < 4; ++c) {
-        g.mass[c] = static_cast<float>(n.energy[c]);
+        const double mass = fl > 0 ? (1.0 - fl) * n.energy[c] + fl * total * childArea[i] : n.energy[c];
+        g.mass[c] = static_cast<float>(mass);
         g.child[c] = n.child[c] == 0 ? 0u : n.child[c] + offset;
+        if (n.child[c] != 0) childArea[n.child[c]] = 0.25 * childArea[i];
       }
       dir.push_back(g);
     }
@@ -345,7 +456,7 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
       // arrival on; nothing when that ray left a scene without environment (-1).
       const double after = arrived < 0.0f ? 0.0 : std::max(0.0, lEnd - double(arrived));
       const std::uint32_t leaf = tree.findLeaf(glm::vec3(a));
-      tree.splatLeaf(leaf, glm::vec3(b), after / double(b.w));
+      tree.splatAt(leaf, glm::vec3(a), glm::vec3(b), after / double(b.w));
       // The same radiance is the vertex's estimate through its sample (y = F / p_mix).
       if (c.x >= 0.0f) tree.observeSelection(leaf, after, c.x, c.y, c.z);
       ++splats;

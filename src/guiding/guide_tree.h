@@ -18,6 +18,10 @@
 // MIS estimate under each candidate alpha of kAlphaCandidates, estimated from the samples drawn
 // with the alpha the iteration used, and the guide is used (alpha = the best candidate) only
 // where it lowers that moment significantly against alpha = 0 (BRDF sampling alone).
+// The splats are box-filtered (settings dirFilter, on by default: shared among the directional
+// cells a box of the landing cell's size overlaps; spatialFilter, off: among the regions a box of
+// the vertex's region's size overlaps), and flatten can mix a uniform density into every trained
+// guide (settings floor, 0 by default). docs/guiding.md, "Splat filtering".
 // Everything runs in a fixed order: the same splats give the same trees, bit for bit.
 #pragma once
 #include <array>
@@ -60,6 +64,20 @@ struct GuideSettings {
   // (3.09: significance 0.001 per candidate, at most 12 x 0.001 over the candidates).
   double alphaMinVertices = 64;
   double alphaZ = 3.09;
+  // Directional splat filter (docs/guiding.md, "Splat filtering"): each splat is spread over a
+  // box of the map the size of the building tree's leaf cell it lands in, centred on its point
+  // (wrapping around in phi, clipped at the poles' edges and renormalised), its value shared among
+  // the leaf cells the box overlaps in proportion to the overlapped area (Mueller et al.'s box
+  // filter). False: the whole value goes to the one cell holding the point.
+  bool dirFilter = true;
+  // Spatial splat filter: each splat is shared among the regions that a box of its own region's
+  // size, centred on the vertex (clipped to the root box and renormalised), overlaps, in
+  // proportion to the overlapped volume (the deterministic expectation of Mueller et al.'s
+  // jittered position). The splat counts of the split rule stay with the vertex's own region.
+  bool spatialFilter = false;
+  // Weight of the uniform sphere density mixed into every trained region's guide (flatten): the
+  // density sampled is (1 - floor) x the tree's + floor / (4 pi), so no direction has density 0.
+  double floor = 0.0;
 };
 
 // A quadtree over the map [0, 1)^2; node 0 is the root. energy[c] of a node = the energy of
@@ -73,6 +91,13 @@ class DirTree {
   DirTree() : m_nodes(1) {}
   // Adds value (>= 0) to the finest cell holding p (and to every cell above it).
   void splat(glm::vec2 p, double value);
+  // Box filter: value (>= 0) spread over the square box of side `side` centred on p, shared among
+  // the leaf cells it overlaps by overlapped area (phi, the map's y, wraps around; the part of the
+  // box outside u in [0, 1) is cut off and the rest renormalised): the tree's total grows by value,
+  // exactly up to rounding. side = 0: splat(p, value).
+  void splatBox(glm::vec2 p, double side, double value);
+  // Side of the leaf cell holding p (1/2 in a tree of one node).
+  double leafSide(glm::vec2 p) const;
   double total() const;
   // This tree's structure refined by its energy, with zero energies: a cell is split when it holds
   // more than `threshold` of the total and is shallower than maxDepth (a cell that was a leaf here
@@ -84,6 +109,8 @@ class DirTree {
   std::uint32_t depth() const;
 
  private:
+  void splatBoxInto(std::uint32_t node, double x0, double y0, double size, double bx0, double bx1, double by0,
+                    double by1, double valuePerArea);
   std::vector<Node> m_nodes;
 };
 
@@ -116,8 +143,11 @@ class GuideTree {
 
   // One splat: value (>= 0) = the radiance estimate arriving at x from direction d divided by the
   // density per steradian with which d was sampled; counts one sample of x's leaf.
-  void splat(glm::vec3 x, glm::vec3 d, double value) { splatLeaf(findLeaf(x), d, value); }
-  void splatLeaf(std::uint32_t leaf, glm::vec3 d, double value);
+  // With the settings' filters: shared among the regions around x (spatialFilter) and the cells
+  // around d (dirFilter); the splat counts of x's own leaf.
+  void splat(glm::vec3 x, glm::vec3 d, double value) { splatAt(findLeaf(x), x, d, value); }
+  // The same for a vertex x known to lie in leaf `leaf` (findLeaf(x)).
+  void splatAt(std::uint32_t leaf, glm::vec3 x, glm::vec3 d, double value);
   // A vertex of leaf `leaf` sampled by the mixture: y = its estimate through the sample (the
   // radiance it carried, >= 0), pdfGuide and pdfBsdf = the guide's and the BRDF sampler's
   // densities at the sampled direction, alpha = the selection probability it was drawn with.
@@ -163,6 +193,10 @@ class GuideTree {
     SelectionStats selection;
   };
   void learnAlphas();
+  // value into leaf's building tree at direction d (its directional filter if set).
+  void splatDirection(std::uint32_t leaf, glm::vec3 d, double value);
+  // The spatial node (a leaf) whose box holds x.
+  std::uint32_t findNode(glm::vec3 x) const;
   float leafGuideAlpha(const Leaf& l) const { return m_settings.alpha >= 0 ? m_settings.alpha : l.alpha; }
   std::uint64_t bytesOf(std::size_t spatialNodes, std::uint64_t dirNodes) const;
 

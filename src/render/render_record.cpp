@@ -104,6 +104,9 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
       meta.strings.push_back({"nusselt/guideAlpha", "auto"});
     else
       meta.doubles.push_back({"nusselt/guideAlpha", r.settings.guideAlpha});
+    meta.strings.push_back({"nusselt/guideFilter", r.settings.guideDirFilter ? "box" : "none"});
+    meta.strings.push_back({"nusselt/guideSpatialFilter", r.settings.guideSpatialFilter ? "box" : "none"});
+    meta.doubles.push_back({"nusselt/guideFloor", r.settings.guideFloor});
     meta.doubles.push_back({"nusselt/guideSpatial", r.settings.guideSpatialThreshold});
     meta.doubles.push_back({"nusselt/guideMemory", double(r.settings.guideMemory)});
     if (!r.guideHash.empty()) meta.strings.push_back({"nusselt/guideHash", r.guideHash});
@@ -220,6 +223,10 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   r.settings.guideAlpha = findString(meta, "nusselt/guideAlpha").value_or("") == "auto"
                               ? -1.0f
                               : static_cast<float>(findDouble(meta, "nusselt/guideAlpha").value_or(0.5));
+  // Files written before the splat filters and the floor existed: unfiltered splats, no floor.
+  r.settings.guideDirFilter = findString(meta, "nusselt/guideFilter").value_or("none") == "box";
+  r.settings.guideSpatialFilter = findString(meta, "nusselt/guideSpatialFilter").value_or("none") == "box";
+  r.settings.guideFloor = findDouble(meta, "nusselt/guideFloor").value_or(0.0);
   r.settings.guideSpatialThreshold = findDouble(meta, "nusselt/guideSpatial").value_or(12000);
   r.settings.guideMemory = static_cast<std::uint64_t>(findDouble(meta, "nusselt/guideMemory").value_or(16 << 20));
   r.guideHash = findString(meta, "nusselt/guideHash").value_or("");

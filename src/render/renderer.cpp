@@ -182,6 +182,9 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
     gs.memoryCap = settings.guideMemory;
     gs.alpha = settings.guideAlpha;
     gs.spatialThreshold = settings.guideSpatialThreshold;
+    gs.dirFilter = settings.guideDirFilter;
+    gs.spatialFilter = settings.guideSpatialFilter;
+    gs.floor = settings.guideFloor;
     m_guide = std::make_unique<DeviceGuide>(m_ctx, lo, hi, gs,
                                             PathIntegrator::capacityFor(settings, pixels, m_samplesPerPass),
                                             settings.maxDepth);

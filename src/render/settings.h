@@ -169,6 +169,11 @@ struct RenderSettings {
   // splats in iteration k. Mueller et al.'s 12000 suits their 1280 x 720 images; small images
   // get few regions with it (docs/guiding.md, measurements).
   double guideSpatialThreshold = 12000;
+  // The guide's splat filters (`--guide-filter`, `--guide-spatial-filter`: box or none) and the
+  // uniform density mixed into it (`--guide-floor`): guiding::GuideSettings, docs/guiding.md.
+  bool guideDirFilter = true;
+  bool guideSpatialFilter = false;
+  double guideFloor = 0.0;
   // The path tracer reads every random number of a path from a primary sample vector in a buffer
   // (PathOptions::primaryDims = PathIntegrator::primaryDimsFor(maxDepth); Renderer::paths()), which
   // the caller fills: for tests of the primary sample source. Not a command-line option.

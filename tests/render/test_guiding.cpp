@@ -35,8 +35,10 @@ double meanDifferenceZ(const Image& a, const Image& b) {
 
 // A guided and an unguided render of `scene` (different seeds: independent estimates) agree;
 // alpha: the guided render's --guide-alpha (< 0: auto, learned per region).
+// spatialFilterAndFloor: with the spatial splat filter and a floor of 0.1 (off by default), and
+// c = 300 (regions to share among).
 void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, std::uint32_t depth, int block,
-                    float alpha = -1.0f) {
+                    float alpha = -1.0f, bool spatialFilterAndFloor = false) {
   RenderSettings s;
   s.width = s.height = size;
   s.spp = spp;
@@ -46,6 +48,11 @@ void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, s
   s.seed = 22;
   s.guiding = true;
   s.guideAlpha = alpha;
+  if (spatialFilterAndFloor) {
+    s.guideSpatialFilter = true;
+    s.guideFloor = 0.1;
+    s.guideSpatialThreshold = 300;  // many regions for the filter to share among
+  }
   Renderer r(test::context(), scene, s);
   r.render(s.spp);
   Image guided = r.image(true);
@@ -77,6 +84,9 @@ void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, s
 TEST(Guiding, UnbiasedOnIndirectlyLitCornellBox) {
   expectUnbiased(test::loadTestScene("scenes/cornell/cornell-indirect.glb"), 32, 64, 6, 4);
   expectUnbiased(test::loadTestScene("scenes/cornell/cornell-indirect.glb"), 32, 64, 6, 4, 0.5f);
+  // The spatial splat filter and the floor (the sampled density and the pdf of MIS and weights
+  // then include the uniform share).
+  expectUnbiased(test::loadTestScene("scenes/cornell/cornell-indirect.glb"), 32, 64, 6, 4, 0.5f, true);
 }
 
 // Combined materials (not guided, they train), mirror and dielectric components (never guided).
@@ -102,9 +112,13 @@ TEST(Guiding, SameSeedIsBitIdentical) {
   s.maxDepth = 5;
   s.seed = 3;
   s.guiding = true;
-  // The learned alpha (auto, the default) and a fixed one.
-  for (float alpha : {-1.0f, 0.5f}) {
+  // The learned alpha (auto, the default) and a fixed one; the fixed one also with the spatial
+  // splat filter and a floor (the default splats are box-filtered in direction).
+  for (float alpha : {-1.0f, 0.5f, 0.25f}) {
     s.guideAlpha = alpha;
+    s.guideSpatialFilter = alpha == 0.25f;
+    s.guideFloor = alpha == 0.25f ? 0.1 : 0.0;
+    s.guideSpatialThreshold = alpha == 0.25f ? 100 : 12000;
     test::Rendered a = test::render(scene, s);
     test::Rendered b = test::render(scene, s);
     ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());

@@ -12,6 +12,7 @@
 #include <random>
 
 #include "guiding/guide_tree.h"
+#include "render/render_record.h"
 #include "test_quadtree_chi2.h"
 
 using namespace nusselt;
@@ -35,10 +36,13 @@ double radiance(glm::vec3 d) {
 }
 
 // A one-leaf guide trained for `iterations` iterations on uniform directions weighted by radiance().
-GuideTree trainedTree(std::uint32_t iterations, std::uint32_t maxDirDepth, std::uint32_t splatsPerIteration = 200000) {
+// floor: the guide's uniform floor (applied when flattened; the trees are the same for any floor).
+GuideTree trainedTree(std::uint32_t iterations, std::uint32_t maxDirDepth, std::uint32_t splatsPerIteration = 200000,
+                      double floor = 0.0) {
   GuideSettings s;
   s.spatialThreshold = 1e30;  // one spatial leaf
   s.maxDirDepth = maxDirDepth;
+  s.floor = floor;
   GuideTree t(glm::vec3(0.0f), glm::vec3(1.0f), s);
   std::mt19937 rng(7);
   for (std::uint32_t it = 0; it < iterations; ++it) {
@@ -109,9 +113,14 @@ TEST(Guiding, MapRoundTripsAndIsEqualArea) {
   EXPECT_GT(qttest::gammaQ(0.5 * (n * n - 1), 0.5 * chi2), 0.001) << "chi2 " << chi2;
 }
 
-TEST(Guiding, PdfIntegratesToOneOverTheSphere) {
+// Without and with the uniform floor (GuideSettings::floor: the flattened masses mix the tree's
+// energy with the cells' areas).
+class GuidingFloor : public ::testing::TestWithParam<double> {};
+INSTANTIATE_TEST_SUITE_P(Guiding, GuidingFloor, ::testing::Values(0.0, 0.1));
+
+TEST_P(GuidingFloor, PdfIntegratesToOneOverTheSphere) {
   const std::uint32_t depth = 8;
-  GuideTree t = trainedTree(5, depth);
+  GuideTree t = trainedTree(5, depth, 200000, GetParam());
   Flat f = flatten(t);
   ASSERT_GT(t.samplingTree(0).total(), 0.0);
   ASSERT_GE(t.samplingTree(0).depth(), 4u) << "the test tree must be refined";
@@ -129,11 +138,35 @@ TEST(Guiding, PdfIntegratesToOneOverTheSphere) {
     }
   EXPECT_NEAR(sumSquare / (double(n) * n), 1.0, 1e-4);
   EXPECT_NEAR(sumSphere / (double(n) * n), 1.0, 1e-4);
+  // With a floor f: the density is (1 - f) x the tree's without it + f at every point (up to float
+  // rounding of the masses), so no direction has density 0.
+  const double fl = GetParam();
+  if (fl > 0) {
+    GuideTree t0 = trainedTree(5, depth, 200000, 0.0);  // the same tree (same splats), no floor
+    Flat f0 = flatten(t0);
+    const std::uint32_t root0 = f0.spatial[0].info.y;
+    double worst = 0, lowest = 1e30;
+    int emptyWithoutFloor = 0;
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        shared::vec2 p((x + 0.5f) / n, (y + 0.5f) / n);
+        const double p0 = shared::guideSquarePdf(f0.view, root0, p);
+        const double pf = shared::guideSquarePdf(f.view, root, p);
+        const double want = (1.0 - fl) * p0 + fl;
+        worst = std::max(worst, std::abs(pf - want) / want);
+        lowest = std::min(lowest, pf);
+        emptyWithoutFloor += p0 == 0.0;
+      }
+    std::printf("floor %.2f: largest relative deviation from (1 - f) p + f: %.3g; lowest density %.4g; %d of %d "
+                "cells empty without the floor\n", fl, worst, lowest, emptyWithoutFloor, n * n);
+    EXPECT_LT(worst, 1e-4);
+    EXPECT_GE(lowest, fl * (1.0 - 1e-4));
+  }
 }
 
-TEST(Guiding, SamplingMatchesPdfChiSquare) {
+TEST_P(GuidingFloor, SamplingMatchesPdfChiSquare) {
   const std::uint32_t depth = 8;
-  GuideTree t = trainedTree(5, depth);
+  GuideTree t = trainedTree(5, depth, 200000, GetParam());
   Flat f = flatten(t);
   const std::uint32_t root = f.spatial[0].info.y;
   // Bins: a 64 x 64 grid of the map (finer than most leaves, coarser than the deepest: the
@@ -319,6 +352,146 @@ TEST(Guiding, SplatsRadianceFromLaterInThePathOverThroughputAndPdf) {
   EXPECT_EQ(t.leafSamples(0), 4.0);
 }
 
+// ---- Splat filtering (GuideSettings::dirFilter, spatialFilter) --------------------------------------
+namespace {
+// A directional tree whose leaf cells are the 4 x 4 cells of side 1/4 (depth 2).
+DirTree uniformDepth2() {
+  DirTree t;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) t.splat(glm::vec2((x + 0.5f) / 4, (y + 0.5f) / 4), 1.0);
+  DirTree u = t.refined(0.01, 2);
+  EXPECT_EQ(u.depth(), 2u);
+  return u;
+}
+// The overlap of [a0, a1] with [b0, b1].
+double overlap(double a0, double a1, double b0, double b1) { return std::max(0.0, std::min(a1, b1) - std::max(a0, b0)); }
+}  // namespace
+
+// The box filter of a directional splat: the box of the side of the cell the point lands in,
+// centred on it, shares the value among the overlapped leaf cells by area (wrapping around in phi,
+// cut at u = 0 and 1 and renormalised): on the 4 x 4 tree each cell's energy is value x its
+// overlap / the box's area, computed here independently; and on a refined tree of many cell sizes
+// the total grows by exactly the splatted value (up to rounding), wherever the point is.
+TEST(Guiding, BoxFilteredSplatSpreadsByOverlapAndConservesItsValue) {
+  struct Case {
+    float x, y;
+    const char* what;
+  };
+  for (const Case& k : {Case{0.3f, 0.4f, "interior: four cells"}, Case{0.5f, 0.05f, "across phi = 0: wraps to y ~ 1"},
+                        Case{0.05f, 0.6f, "at the pole u = 0: cut, renormalised"},
+                        Case{0.98f, 0.99f, "the pole u = 1 and phi = 1 at once"}, Case{0.125f, 0.375f, "a cell's centre: one cell"}}) {
+    DirTree t = uniformDepth2();
+    const glm::vec2 p(k.x, k.y);
+    const double side = t.leafSide(p);
+    EXPECT_EQ(side, 0.25) << k.what;
+    t.splatBox(p, side, 3.0);
+    // Expected: the box clipped in x to [0, 1], wrapped in y (three periods cover the wrap).
+    const double bx0 = std::max(0.0, k.x - 0.125), bx1 = std::min(1.0, k.x + 0.125);
+    const double area = (bx1 - bx0) * 0.25;
+    int touched = 0;
+    for (int cy = 0; cy < 4; ++cy)
+      for (int cx = 0; cx < 4; ++cx) {
+        const double ox = overlap(bx0, bx1, cx / 4.0, (cx + 1) / 4.0);
+        double oy = 0;
+        for (int w = -1; w <= 1; ++w) oy += overlap(k.y - 0.125, k.y + 0.125, cy / 4.0 + w, (cy + 1) / 4.0 + w);
+        const double want = 3.0 * ox * oy / area;
+        const double got = cellEnergy(t, cx / 4.0, cy / 4.0, 0.25);
+        EXPECT_NEAR(got, want, 1e-12) << k.what << ": cell " << cx << ", " << cy;
+        touched += got > 0;
+      }
+    EXPECT_NEAR(t.total(), 3.0, 1e-12) << k.what;
+    std::printf("%s: %d cells\n", k.what, touched);
+  }
+  // Conservation on a tree of many cell sizes (the trained lobes' tree, depth up to 12), at
+  // random points including the seams: each splat adds its value to the total.
+  GuideTree trained = trainedTree(3, 12, 50000);
+  const DirTree zero = trained.buildingTree(0);  // the refined structure, energies 0
+  DirTree t = zero;
+  ASSERT_GT(t.depth(), 6u);
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> U(0.0f, 1.0f);
+  double sum = 0, worst = 0;
+  std::uint32_t spread = 0;
+  for (int i = 0; i < 20000; ++i) {
+    glm::vec2 p(U(rng), U(rng));
+    if (i % 4 == 1) p.x = 1e-4f * U(rng);                  // at the pole u = 0
+    if (i % 4 == 2) p.y = 1.0f - 1e-4f * U(rng);           // at the phi seam
+    p = glm::min(p, glm::vec2(NUSSELT_ONE_MINUS_EPS));
+    const double v = std::exp(8.0 * U(rng));
+    t.splatBox(p, t.leafSide(p), v);
+    sum += v;
+    if (i < 2000) {  // one splat alone in the empty tree: its total is the value
+      DirTree z = zero;
+      z.splatBox(p, z.leafSide(p), v);
+      worst = std::max(worst, std::abs(z.total() - v) / v);
+    }
+    DirTree one = uniformDepth2();
+    one.splatBox(p, 0.25, 1.0);
+    spread += cellEnergy(one, std::floor(p.x * 4) / 4, std::floor(p.y * 4) / 4, 0.25) < 1.0 - 1e-12;
+  }
+  std::printf("box splats: largest relative error of one splat's total %.3g (2000 splats), of 20000 splats' %.3g; "
+              "%u of 20000 shared with a neighbouring cell\n", worst, std::abs(t.total() - sum) / sum, spread);
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_NEAR(t.total(), sum, 1e-12 * sum);
+  // A box the size of its cell leaves its own cell's share (1 - |dx|)(1 - |dy|) of it: almost every
+  // random point shares with a neighbour.
+  EXPECT_GT(spread, 19000u);
+}
+
+// The spatial filter: a splat shared among the regions a box of its region's size around the
+// vertex overlaps, by the overlapped volume over the box's (clipped to the root box), each share
+// in that region's directional tree; the splat count stays with the vertex's region. Regions of
+// the split rule's test (16 leaves of a 4 x 2 x 1 box).
+TEST(Guiding, SpatialFilterSharesASplatAmongRegionsByOverlappedVolume) {
+  GuideSettings s;
+  s.spatialThreshold = 100;
+  s.spatialFilter = true;
+  GuideTree t(glm::vec3(0.0f), glm::vec3(4.0f, 2.0f, 1.0f), s);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> U(0.0f, 1.0f);
+  for (int i = 0; i < 1000; ++i) t.splat(glm::vec3(4 * U(rng), 2 * U(rng), U(rng)), glm::vec3(0, 0, 1), 1.0);
+  t.endIteration(0);
+  ASSERT_EQ(t.leafCount(), 16u);
+  // Near inner boundaries (shared), and at the root box's corner (the box cut there: its own
+  // region only, the whole value kept).
+  for (glm::vec3 x : {glm::vec3(1.9f, 0.55f, 0.45f), glm::vec3(3.0f, 1.5f, 0.8f), glm::vec3(0.01f, 0.01f, 0.01f)}) {
+    GuideTree u = t;
+    const std::uint32_t home = u.findLeaf(x);
+    u.splat(x, glm::vec3(0, 0, 1), 2.0);
+    glm::vec3 hlo, hhi;
+    u.leafBounds(home, hlo, hhi);
+    const glm::dvec3 half = 0.5 * (glm::dvec3(hhi) - glm::dvec3(hlo));
+    const glm::dvec3 blo = glm::max(glm::dvec3(x) - half, glm::dvec3(u.boundsMin()));
+    const glm::dvec3 bhi = glm::min(glm::dvec3(x) + half, glm::dvec3(u.boundsMax()));
+    const double volume = (bhi.x - blo.x) * (bhi.y - blo.y) * (bhi.z - blo.z);
+    double total = 0;
+    int shared = 0;
+    for (std::uint32_t l = 0; l < u.leafCount(); ++l) {
+      glm::vec3 lo, hi;
+      u.leafBounds(l, lo, hi);
+      double v = 1;
+      for (int a = 0; a < 3; ++a) v *= overlap(blo[a], bhi[a], lo[a], hi[a]);
+      const double got = u.buildingTree(l).total();
+      EXPECT_NEAR(got, 2.0 * v / volume, 1e-12) << "leaf " << l;
+      total += got;
+      shared += got > 0;
+      EXPECT_EQ(u.leafSamples(l), l == home ? 1.0 : 0.0);
+    }
+    EXPECT_NEAR(total, 2.0, 1e-12);
+    std::printf("vertex (%.2f, %.2f, %.2f): shared among %d regions\n", x.x, x.y, x.z, shared);
+    EXPECT_GE(shared, x.x < 1.0f ? 1 : 2);
+  }
+  // Without the filter the whole splat stays in the vertex's region.
+  s.spatialFilter = false;
+  GuideTree v(glm::vec3(0.0f), glm::vec3(4.0f, 2.0f, 1.0f), s);
+  std::mt19937 rng2(5);
+  for (int i = 0; i < 1000; ++i) v.splat(glm::vec3(4 * U(rng2), 2 * U(rng2), U(rng2)), glm::vec3(0, 0, 1), 1.0);
+  v.endIteration(0);
+  const glm::vec3 x(1.9f, 0.55f, 0.45f);
+  v.splat(x, glm::vec3(0, 0, 1), 2.0);
+  EXPECT_NEAR(v.buildingTree(v.findLeaf(x)).total(), 2.0, 1e-12);
+}
+
 // The selection probability per region (GuideTree::observeSelection, learnAlphas) on a one-leaf
 // guide trained on radiance() (a sharp lobe, a broad one, a floor): vertices whose "BRDF sampler"
 // is uniform over the sphere (p_bsdf = 1 / 4 pi), sampled with alpha = 0 (the leaf's first alpha).
@@ -391,4 +564,45 @@ TEST(Guiding, LearnedAlphaPrefersAGoodGuideAndFallsBackWhereBsdfSamplingIsExact)
   t.endIteration(5);
   EXPECT_EQ(t.leafAlpha(0), 0.0f);
   EXPECT_EQ(t.leafAlphaVertices(0), 0.0);
+}
+
+// The filter and floor settings in the EXR header (render_record.cpp): written for guided renders,
+// read back as written; a guided header written before they existed reads as unfiltered splats
+// without floor (the behaviour of those files).
+TEST(Guiding, FilterSettingsRoundTripThroughTheRecord) {
+  RenderRecord r;
+  r.scene = "scene.gltf";
+  r.spp = 4;
+  r.settings.guiding = true;
+  r.settings.guideDirFilter = false;
+  r.settings.guideSpatialFilter = true;
+  r.settings.guideFloor = 0.05;
+  ImageMetadata meta = makeMetadata(r);
+  RenderRecord back = readRecord("test.exr", meta);
+  EXPECT_TRUE(back.settings.guiding);
+  EXPECT_FALSE(back.settings.guideDirFilter);
+  EXPECT_TRUE(back.settings.guideSpatialFilter);
+  EXPECT_EQ(back.settings.guideFloor, 0.05);
+  r.settings.guideDirFilter = true;
+  r.settings.guideSpatialFilter = false;
+  r.settings.guideFloor = 0;
+  back = readRecord("test.exr", makeMetadata(r));
+  EXPECT_TRUE(back.settings.guideDirFilter);
+  EXPECT_FALSE(back.settings.guideSpatialFilter);
+  // An older guided header: the keys absent.
+  auto drop = [](auto& v) {
+    v.erase(std::remove_if(v.begin(), v.end(),
+                           [](const auto& kv) {
+                             return kv.first == "nusselt/guideFilter" || kv.first == "nusselt/guideSpatialFilter" ||
+                                    kv.first == "nusselt/guideFloor";
+                           }),
+            v.end());
+  };
+  drop(meta.strings);
+  drop(meta.doubles);
+  back = readRecord("old.exr", meta);
+  EXPECT_TRUE(back.settings.guiding);
+  EXPECT_FALSE(back.settings.guideDirFilter);
+  EXPECT_FALSE(back.settings.guideSpatialFilter);
+  EXPECT_EQ(back.settings.guideFloor, 0.0);
 }
