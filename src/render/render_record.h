@@ -33,6 +33,9 @@ struct RenderRecord {
   std::string environment = "none";
   double envScale = 1, envRotate = 0;
   std::string envSelect = "half";  // --env-select
+  // Binned sampling (settings.roughnessBins, roughnessBinSpacing): the bins the render built, 0 when
+  // its scene has no material that needs them (then the header has no bin attributes).
+  std::uint32_t roughnessBins = 0;
 };
 
 // The record's description of an environment ("none", "uniform R,G,B", "map FILE"); a scene's
