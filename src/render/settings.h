@@ -141,7 +141,7 @@ struct RenderSettings {
   // materials"): the number of roughness bins K (0: no bins, such materials sample the cosine) and
   // their spacing, r_j = (j / (K - 1))^spacing. Defaults from `nusselt bench bins`.
   std::uint32_t roughnessBins = 8;
-  float roughnessBinSpacing = 1.0f;
+  float roughnessBinSpacing = 2.0f;
   // Sample indices of this render start here (`--spp-offset`): a frame can be split across
   // machines into disjoint sample ranges and merged (`nusselt merge`).
   std::uint32_t sampleOffset = 0;
