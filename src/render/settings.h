@@ -140,7 +140,7 @@ struct RenderSettings {
   // shaders/shared/bsdf_sampling.h, "Binned sampling"; docs/scenes.md, "Sampling textured
   // materials"): the number of roughness bins K (0: no bins, such materials sample the cosine) and
   // their spacing, r_j = (j / (K - 1))^spacing. Defaults from `nusselt bench bins`.
-  std::uint32_t roughnessBins = 8;
+  std::uint32_t roughnessBins = 16;
   float roughnessBinSpacing = 2.0f;
   // Sample indices of this render start here (`--spp-offset`): a frame can be split across
   // machines into disjoint sample ranges and merged (`nusselt merge`).
