@@ -55,14 +55,15 @@ Scene texturedFloor() {
   floor.metallicFactor = 1.0f;
   floor.roughnessFactor = 1.0f;
   floor.baseColorTexture = nearestTexture(s, 4, 2,
-                                          {{250, 200, 150, 255}, {230, 230, 230, 255}, {200, 120, 60, 255}, {90, 160, 240, 255},
-                                           {180, 180, 180, 255}, {240, 80, 60, 255}, {60, 200, 90, 255}, {220, 220, 120, 255}},
+                                          {{180, 180, 180, 255}, {240, 80, 60, 255}, {60, 200, 90, 255}, {220, 220, 120, 255},
+                                           {250, 200, 150, 255}, {230, 230, 230, 255}, {200, 120, 60, 255}, {90, 160, 240, 255}},
                                           ColorSpace::Srgb);
-  // (0, G roughness, B metallic): near-mirror, glossy and rough metals; glossy and rough
-  // dielectrics; half metals.
+  // (0, G roughness, B metallic): top row (y > 0) glossy and rough dielectrics and a half metal;
+  // bottom row (y < 0, where the camera sees the lamp's mirror image) near-mirror, glossy and
+  // rough metals.
   floor.metallicRoughnessTexture = nearestTexture(s, 4, 2,
-                                                  {{0, 13, 255, 255}, {0, 51, 255, 255}, {0, 128, 255, 255}, {0, 230, 255, 255},
-                                                   {0, 26, 0, 255}, {0, 90, 0, 255}, {0, 255, 0, 255}, {0, 64, 128, 255}},
+                                                  {{0, 26, 0, 255}, {0, 90, 0, 255}, {0, 255, 0, 255}, {0, 64, 128, 255},
+                                                   {0, 13, 255, 255}, {0, 51, 255, 255}, {0, 128, 255, 255}, {0, 230, 255, 255}},
                                                   ColorSpace::Linear);
   s.materials.push_back(floor);
   Material lamp = catalogueMaterial("lambert", {{"rho", ParamValue::num(0.0)}}, "lamp");
