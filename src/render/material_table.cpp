@@ -132,8 +132,9 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     for (std::size_t i = 0; i < scene.materials.size(); ++i) {
       if (!used[i]) continue;
       const Material& m = scene.materials[i];
-      // A texture that varies the BRDF's parameters over the surface: no one table fits, the
-      // strategy falls back to cosine (INVALID_INDEX; docs/scenes.md, "Textures").
+      // A texture that varies the BRDF's parameters over the surface: no one table fits
+      // (INVALID_INDEX): gltf_pbr under the quadtree samples the roughness bins above
+      // (MATERIAL_BINNED), the rest falls back to cosine (docs/scenes.md, "Sampling textured materials").
       if (!m.combined() && !modelById(m.model).delta && !textureUse(m, scene).paramsVary()) {
         toBuild.push_back({m.model, m.params});
         uses.push_back({static_cast<std::uint32_t>(i), -1});
