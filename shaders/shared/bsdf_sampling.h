@@ -171,6 +171,139 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
   return true;
 }
 
+// ---- Binned sampling: gltf_pbr whose textures vary its parameters (issue 18) ----------------------
+// No one tree fits a material whose baseColor, metallic and roughness change per texel, and a tree
+// per texel is out of reach. The material is sampled instead from a mixture built at the hit:
+//   pdf(wi) = c_d cos / pi + (1 - c_d) [(1 - t) q_j(wi) + t q_{j+1}(wi)]
+// q_j = the quadtree density (quadPdf) of the pure specular lobe at roughness r_j (gltf_pbr with
+// baseColor 1, metallic 1: F = 1, no diffuse part), one set per bin shared by every such material
+// of the scene (RoughnessBins, quadtree_layout.h); r_j <= r <= r_{j+1} the texel's roughness,
+// t = (r - r_j) / (r_{j+1} - r_j) (binLocate). c_d (binnedDiffuseChoice) weighs the texel's diffuse
+// albedo against its specular one; it is a function of wo and the texel only and at least
+// BIN_COSINE_FLOOR, so the cosine part covers the whole hemisphere whatever the trees do.
+// The sample is weighted with the texel's own f: weight = f cos / pdf, pdf the EXACT mixture density
+// above (binnedPdf), which MIS uses too: unbiased for any bins and any c_d. The component and the
+// bin are chosen by remapping u.x (u.x < c_d: cosine with u.x / c_d, and so on), so the sample
+// stays a function of u alone (the trees' further numbers come from the stream of the remapped u).
+// Bins: r_j = (j / (K - 1))^spacing; spacing 1 is uniform in roughness, 2 puts more bins at low
+// roughness where the lobe changes fastest (docs/scenes.md, "Sampling textured materials").
+#define BIN_COSINE_FLOOR 0.05f
+
+// The roughness of bin j of K bins.
+SHARED_FN float binRoughness(RoughnessBins B, uint j) {
+  if (j == 0u) return 0.0f;
+  if (j + 1u >= B.count) return 1.0f;
+  return pow(float(j) / float(B.count - 1u), B.spacing);
+}
+
+// The bins j, j + 1 around roughness r (clamped to [0, 1]) and the weight t of bin j + 1.
+SHARED_FN void binLocate(RoughnessBins B, float r, OUT(uint) j, OUT(float) t) {
+  float rc = clamp(r, 0.0f, 1.0f);
+  float x = pow(rc, 1.0f / B.spacing) * float(B.count - 1u);
+  j = min(uint(x), B.count - 2u);
+  // The power's rounding may put r just outside [r_j, r_{j+1}]: step to the right pair.
+  if (j > 0u && rc < binRoughness(B, j)) j -= 1u;
+  if (j + 2u < B.count && rc > binRoughness(B, j + 1u)) j += 1u;
+  float r0 = binRoughness(B, j);
+  float r1 = binRoughness(B, j + 1u);
+  t = clamp((rc - r0) / (r1 - r0), 0.0f, 1.0f);
+}
+
+// The parameters the bins' trees were built for (and are evaluated with): the pure specular lobe.
+SHARED_FN BrdfParams binParams(float r) {
+  BrdfParams q;
+  for (uint i = 0u; i < uint(BRDF_PARAM_VEC4S); ++i) q.v[i] = vec4(0.0f);
+  q.v[0] = vec4(1.0f, 1.0f, 1.0f, 1.0f);  // baseColor (1, 1, 1), metallic 1
+  q.v[GLTF_PBR_ROUGHNESS / 4u][GLTF_PBR_ROUGHNESS % 4u] = r;
+  return q;
+}
+
+// The probability c_d of the cosine part for the texel p and wo: its diffuse albedo estimate
+// (1 - lum F(wo.z)) lum(cdiff) against the specular one lum F(wo.z) x the bins' tabulated albedo
+// at wo (quadAlbedo, mixed like the trees), floored at BIN_COSINE_FLOOR.
+SHARED_FN float binnedDiffuseChoice(RoughnessBins B, BrdfParams p, vec3 wo, uint j, float t) {
+  vec3 base = brdfParam3(p, GLTF_PBR_BASE_COLOR);
+  float metallic = clamp(brdfParam(p, GLTF_PBR_METALLIC), 0.0f, 1.0f);
+  vec3 f0 = mix(vec3(0.04f), base, metallic);
+  float F = luminance(fresnelSchlick3(wo.z, f0));
+  float d = (1.0f - F) * luminance(base) * (1.0f - metallic);
+  float phi = portableAtan2(wo.y, wo.x);
+  float a = 0.0f;
+  if (t < 1.0f) a += (1.0f - t) * quadAlbedo(B.first + j, wo.z, phi);
+  if (t > 0.0f) a += t * quadAlbedo(B.first + j + 1u, wo.z, phi);
+  float s = F * a;
+  float cd = d + s > 0.0f ? d / (d + s) : 1.0f;
+  return clamp(cd, BIN_COSINE_FLOOR, 1.0f);
+}
+
+// The mixture's density at wi (solid angle), given its choice c_d and bins (j, t).
+SHARED_FN float binnedMixturePdf(RoughnessBins B, float cd, uint j, float t, vec3 wo, vec3 wi) {
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
+  float pdf = cd * cosineHemispherePdf(wi);
+  if (t < 1.0f) pdf += (1.0f - cd) * (1.0f - t) * quadPdf(B.first + j, MODEL_GLTF_PBR, binParams(binRoughness(B, j)), wo, wi);
+  if (t > 0.0f)
+    pdf += (1.0f - cd) * t * quadPdf(B.first + j + 1u, MODEL_GLTF_PBR, binParams(binRoughness(B, j + 1u)), wo, wi);
+  return pdf;
+}
+
+// The density with which binnedSample draws wi for the texel parameters p (gltf_pbr): for MIS.
+SHARED_FN float binnedPdf(RoughnessBins B, BrdfParams p, vec3 wo, vec3 wi) {
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
+  uint j;
+  float t;
+  binLocate(B, brdfParam(p, GLTF_PBR_ROUGHNESS), j, t);
+  return binnedMixturePdf(B, binnedDiffuseChoice(B, p, wo, j, t), j, t, wo, wi);
+}
+
+// Draws wi for the texel parameters p (gltf_pbr) and wo.z > 0 with density pdf = binnedPdf, and
+// returns f = gltfPbrEval(p, wi, wo). False for a failed sample (a tree's rejection cap, below the
+// surface).
+SHARED_FN bool binnedSample(RoughnessBins B, BrdfParams p, vec3 wo, vec2 u, OUT(vec3) wi, OUT(float) pdf, OUT(vec3) f) {
+  wi = vec3(0.0f, 0.0f, 1.0f);
+  pdf = 0.0f;
+  f = vec3(0.0f);
+  if (wo.z <= 0.0f) return false;
+  uint j;
+  float t;
+  binLocate(B, brdfParam(p, GLTF_PBR_ROUGHNESS), j, t);
+  float cd = binnedDiffuseChoice(B, p, wo, j, t);
+  const float below1 = 0.99999994f;  // the largest float below 1
+  if (u.x < cd) {
+    wi = squareToCosineHemisphere(vec2(min(u.x / cd, below1), u.y));
+  } else {
+    float x = min((u.x - cd) / (1.0f - cd), below1);
+    uint k = j;
+    if (t >= 1.0f || (t > 0.0f && x >= 1.0f - t)) {
+      k = j + 1u;
+      x = t >= 1.0f ? x : (x - (1.0f - t)) / t;
+    } else if (t > 0.0f) {
+      x = x / (1.0f - t);
+    }
+    float qpdf;
+    vec3 qf;
+    if (!quadSample(B.first + k, MODEL_GLTF_PBR, binParams(binRoughness(B, k)), wo, vec2(min(x, below1), u.y), wi,
+                    qpdf, qf))
+      return false;
+  }
+  if (wi.z <= 0.0f) return false;
+  pdf = binnedMixturePdf(B, cd, j, t, wo, wi);
+  if (!(pdf > 0.0f)) return false;
+  f = gltfPbrEval(p, wi, wo);
+  return true;
+}
+
+// bsdfSample for a binned material: weight f cos / pdf, continuation min(1, luminance(weight)).
+SHARED_FN bool binnedBsdfSample(RoughnessBins B, BrdfParams p, vec3 wo, vec2 u, OUT(vec3) wi, OUT(vec3) weight,
+                                OUT(float) pdf, OUT(float) continuation) {
+  weight = vec3(0.0f);
+  continuation = 0.0f;
+  vec3 f;
+  if (!binnedSample(B, p, wo, u, wi, pdf, f)) return false;
+  weight = f * (wi.z / pdf);
+  continuation = min(1.0f, luminance(weight));
+  return true;
+}
+
 // The throughput roulette (ROULETTE_THROUGHPUT): from bounce ROULETTE_MIN_BOUNCE on, the walk goes on
 // with probability q = min(1, max_c beta_c x etaScale) and the survivors are divided by q (unbiased:
 // E[beta'] = q beta / q). beta already includes this bounce's sample weight. No channel grows: a

@@ -85,6 +85,9 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 #define MATERIAL_TEXTURED 8u  // a texture applies (Globals.materialTextures: GpuMaterialTextures)
 #define MATERIAL_ALPHA 16u    // alphaMode MASK or BLEND: hits are tested in traversal (trace.glsl)
 #define MATERIAL_ABSORBING 32u  // a refracting volume that absorbs (GpuMaterial.absorption; volume.h)
+// gltf_pbr whose textures vary its parameters, under the quadtree strategy: sampled by the binned
+// mixture of Globals.roughnessBins (bsdf_sampling.h, "Binned sampling"); info.z is INVALID_INDEX.
+#define MATERIAL_BINNED 64u
 
 // ---- Combined materials ---------------------------------------------------------------------------
 // At most this many components per material: the shade stage is specialised per tuple of component
@@ -378,8 +381,10 @@ struct Globals {
   // (shaders/shared/trace.glsl with NUSSELT_RAY_QUERY); 0 when the GLSL BVH traces.
   uint tlasLow;
   uint tlasHigh;
+  // The roughness bins of the scene's textured gltf_pbr materials (MATERIAL_BINNED; count 0: none).
+  RoughnessBins roughnessBins;
 };
-STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 40 * 8 + 8);
+STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 40 * 8 + 8 + 16);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 

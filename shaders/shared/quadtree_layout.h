@@ -101,5 +101,17 @@ struct QuadSet {
 };
 STATIC_ASSERT_SIZE(QuadSet, 32);
 
+// Roughness bins (issue 18; bsdf_sampling.h, "Binned sampling"): the quadtree sets of gltf_pbr with
+// baseColor 1, metallic 1 (the pure GGX/Smith lobe, F = 1) at roughness r_j = (j / (count - 1))^spacing,
+// j = 0 .. count - 1, sets first .. first + count - 1; shared by every gltf_pbr material whose
+// textures vary its parameters. count = 0: no bins (then nothing reads them).
+struct RoughnessBins {
+  uint first;
+  uint count;
+  float spacing;
+  uint reserved;
+};
+STATIC_ASSERT_SIZE(RoughnessBins, 16);
+
 SHARED_END
 #endif

@@ -156,9 +156,20 @@ struct PathStep {
 // nextEvent and continuePath below are written once over them.
 #if !SHADE_COMBINED
 // ---- A single-model material (MODEL_ID); guided where the guide has learned (guiding.h) ----
+// Binned sampling (bsdf_sampling.h, "Binned sampling"): a gltf_pbr material whose textures vary its
+// parameters (MATERIAL_BINNED) under the quadtree strategy, in a scene that has such materials
+// (constant 12, HAS_BINS: set by the integrator when Globals.roughnessBins.count > 0; without it,
+// and in modules without the scene features or the quadtree, the code is not there).
+#define NUSSELT_BINNED (NUSSELT_SCENE_FEATURES && NUSSELT_WITH_QUADTREE)
+#if NUSSELT_BINNED
+layout(constant_id = 12) const bool HAS_BINS = false;
+#endif
 struct ShadeMaterial {
   GpuMaterial M;
   GuideVertex gv;  // the guide's region (path guiding): never for delta or transmitting models
+#if NUSSELT_BINNED
+  bool binned;     // MATERIAL_BINNED, with HAS_BINS and MODEL_ID gltf_pbr
+#endif
 };
 
 // inside: the path arrived from the inside (the back of the front face). A transmitting model
@@ -175,7 +186,27 @@ ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, float
   }
   m.gv = GuideVertex(0u, 0.0f);
   if (GUIDING && !modelIsDelta(MODEL_ID) && !modelTransmits(MODEL_ID)) m.gv = guideVertex(x);
+#if NUSSELT_BINNED
+  m.binned = HAS_BINS && MODEL_ID == MODEL_GLTF_PBR && (M.info.y & MATERIAL_BINNED) != 0u;
+#endif
   return m;
+}
+
+// The BSDF sampler's density of wi (bsdfPdf, or the binned mixture's).
+float shadeBsdfPdf(ShadeMaterial m, vec3 wo, vec3 wi) {
+#if NUSSELT_BINNED
+  if (HAS_BINS && m.binned) return binnedPdf(g.roughnessBins, m.M.params, wo, wi);
+#endif
+  return bsdfPdf(SAMPLER, MODEL_ID, m.M.info.z, m.M.params, wo, wi);
+}
+
+// The BSDF sampler's sample (bsdfSample, or the binned mixture's).
+bool shadeBsdfSample(ShadeMaterial m, vec3 wo, bool inside, vec2 u, out vec3 wi, out vec3 weight, out float pdf,
+                     out float q) {
+#if NUSSELT_BINNED
+  if (HAS_BINS && m.binned) return binnedBsdfSample(g.roughnessBins, m.M.params, wo, u, wi, weight, pdf, q);
+#endif
+  return bsdfSample(SAMPLER, MODEL_ID, m.M.info.z, m.M.params, wo, inside, u, wi, weight, pdf, q);
 }
 
 bool shadeLightSamples(ShadeMaterial m) { return !modelIsDelta(MODEL_ID); }
@@ -185,7 +216,7 @@ bool shadeTransmits(ShadeMaterial m) { return modelTransmits(MODEL_ID); }
 vec3 shadeEval(ShadeMaterial m, vec3 wi, vec3 wo) { return brdfEval(MODEL_ID, m.M.params, wi, wo); }
 
 float shadeMisPdf(ShadeMaterial m, vec3 wo, vec3 wi, vec3 wiWorld) {
-  float pdfB = bsdfPdf(SAMPLER, MODEL_ID, m.M.info.z, m.M.params, wo, wi);
+  float pdfB = shadeBsdfPdf(m, wo, wi);
   if (GUIDING) pdfB = guideMixture(m.gv, wiWorld, pdfB);
   return pdfB;
 }
@@ -214,13 +245,13 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
     weight = brdfEval(MODEL_ID, m.M.params, wiLocal, wo) * wiLocal.z;  // f cos, over the mixture below
     pdf = 1.0f;
     q = 1.0f;
-  } else if (!bsdfSample(SAMPLER, MODEL_ID, m.M.info.z, m.M.params, wo, inside, uB, wiLocal, weight, pdf, q))
+  } else if (!shadeBsdfSample(m, wo, inside, uB, wiLocal, weight, pdf, q))
     return false;
   // Training records need both densities wherever the guide could be chosen, also where alpha is
   // 0 (the trainer estimates from them what another alpha would do: GuideTree::observeSelection).
   bool record = GUIDING && !modelIsDelta(MODEL_ID) && guideRecording();
   if (GUIDING && (m.gv.alpha > 0.0f || record)) {
-    float pdfB = guided ? bsdfPdf(SAMPLER, MODEL_ID, m.M.info.z, m.M.params, wo, wiLocal) : pdf;
+    float pdfB = guided ? shadeBsdfPdf(m, wo, wiLocal) : pdf;
     float pdfG = guideDensity(m.gv, toWorld(wiLocal, tt, bb, ns));
     s.selection = vec3(pdfG, pdfB, m.gv.alpha);
     if (m.gv.alpha > 0.0f) {

@@ -17,6 +17,9 @@ STAGE_PUSH(SampleToolConstants);
 layout(local_size_x = WORKGROUP_SIZE) in;
 layout(constant_id = 0) const uint MODEL_ID = 0u;
 layout(constant_id = 1) const uint SAMPLER = SAMPLER_QUADTREE;
+// Binned sampling of gltf_pbr texel parameters (materials.v[0].params, flag MATERIAL_BINNED) with
+// Globals.roughnessBins: the GPU side of the binned sampler's parity test (bsdf_sampling.h).
+layout(constant_id = 2) const bool BINNED = false;
 
 void main() {
   uint local = gl_GlobalInvocationID.x;
@@ -29,7 +32,11 @@ void main() {
   vec3 w;
   float pdf;
   vec3 f;
-  bool ok = strategySample(SAMPLER, MODEL_ID, M.info.z, M.params, v, u, w, pdf, f);
+  bool ok;
+  if (BINNED && MODEL_ID == MODEL_GLTF_PBR && SAMPLER == SAMPLER_QUADTREE && (M.info.y & MATERIAL_BINNED) != 0u)
+    ok = binnedSample(g.roughnessBins, M.params, v, u, w, pdf, f);
+  else
+    ok = strategySample(SAMPLER, MODEL_ID, M.info.z, M.params, v, u, w, pdf, f);
   g.film.v[i] = vec4(w, ok ? pdf : 0.0f);
   g.filmSq.v[i] = vec4(f, ok ? 1.0f : 0.0f);
 }

@@ -52,6 +52,8 @@ struct RenderArgs {
   std::string lighting = "mis";
   std::string rng = "pcg";
   std::string sampler = "quadtree";
+  std::uint32_t roughnessBins = RenderSettings{}.roughnessBins;
+  float roughnessBinSpacing = RenderSettings{}.roughnessBinSpacing;
   std::string components = "albedo";
   std::string roulette = "throughput";
   std::string traversal = "auto";
@@ -113,6 +115,8 @@ int renderCommand(const RenderArgs& a) {
   parseLighting(a.lighting, s.lighting);
   parseRngMode(a.rng, s.rng);
   parseSampler(a.sampler, s.sampler);
+  s.roughnessBins = a.roughnessBins;
+  s.roughnessBinSpacing = a.roughnessBinSpacing;
   parseComponentSelection(a.components, s.components);
   parseRouletteMode(a.roulette, s.roulette);
   parseTraversal(a.traversal, s.traversal);
@@ -226,6 +230,7 @@ int renderCommand(const RenderArgs& a) {
     base.device = ctx.deviceName;
     base.driver = ctx.driverInfo;
     base.models = models;
+    base.roughnessBins = sum.roughnessBins;
     if (!a.resume.empty()) {
       if (previous.device != ctx.deviceName && !a.quiet)
         std::fprintf(stderr, "warning: %s was rendered on %s; continuing on %s (not bit-identical to an uninterrupted render)\n",
@@ -255,6 +260,9 @@ int renderCommand(const RenderArgs& a) {
         std::fprintf(stderr, "sampler: %u quadtrees (%.1f MiB) in %.2f s (cache: %u hits, %u built, %u rejected)\n",
                      sum.samplerTrees, sum.samplerBytes / 1048576.0, sum.samplerSeconds, sum.samplerCacheHits,
                      sum.samplerCacheMisses, sum.samplerCacheRejected);
+      if (sum.roughnessBins)
+        std::fprintf(stderr, "sampler: textured gltf_pbr sampled with %u roughness bins (spacing %g, %.1f MiB of the trees)\n",
+                     sum.roughnessBins, s.roughnessBinSpacing, sum.binBytes / 1048576.0);
       std::string budget = a.timeBudget > 0 ? ", time budget " + std::to_string(a.timeBudget) + " s" : "";
       std::fprintf(stderr, "device: %s (%s); %ux%u, %s spp%s%s (%u per pass), max depth %u, seed %u, lighting %s, rng %s, sampler %s, "
                            "roulette %s, traversal %s, integrator %s%s\n",
@@ -781,6 +789,12 @@ int runCli(int argc, char** argv) {
                                               "density proportional to BRDF x cos for any model), cosine, uniform, analytic (the model's "
                                               "own importance sampling, cosine where it has none), tabulated")
       ->capture_default_str()->check(CLI::IsMember(enumNames(kSamplerNames)));
+  render->add_option("--roughness-bins", ra.roughnessBins, "quadtree: roughness bins of the binned sampler of gltf_pbr "
+                                                          "materials whose textures vary their parameters (0: cosine "
+                                                          "sampling for those; docs/scenes.md)")
+      ->capture_default_str()->check(CLI::Range(0u, 64u) & !CLI::IsMember({1u}));
+  render->add_option("--roughness-bin-spacing", ra.roughnessBinSpacing, "quadtree: bin j of K at roughness (j / (K - 1))^spacing")
+      ->capture_default_str()->check(CLI::Range(0.25f, 4.0f));
   render->add_option("--components", ra.components, "Component choice of combined materials: albedo (probability = "
                                                     "the component's albedo for the current direction, the rest ends "
                                                     "the walk: the random-walk source's estimator) or uniform "

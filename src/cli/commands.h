@@ -18,6 +18,8 @@ using CommandRunner = std::function<int()>;
 void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run);
 // `nusselt bench error` (src/cli/bench_error.cpp); registered by registerSamplerCommands.
 void registerBenchError(CLI::App& bench, CommandRunner& run);
+// `nusselt bench bins` (src/cli/bench_bins.cpp); registered by registerSamplerCommands.
+void registerBenchBins(CLI::App& bench, CommandRunner& run);
 // `nusselt preview` (src/cli/preview.cpp).
 void registerPreviewCommand(CLI::App& app, CommandRunner& run);
 // `nusselt models` (src/cli/models_command.cpp).

@@ -370,6 +370,7 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
   pre->callback([ba, &run]() { run = [ba]() { return benchPrecompute(*ba); }; });
 
   registerBenchError(bench, run);
+  registerBenchBins(bench, run);
 }
 
 }  // namespace nusselt

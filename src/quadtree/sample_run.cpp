@@ -96,7 +96,7 @@ SampleBatch sampleCpuStrategy(std::uint32_t strategy, const sampling::TabulatedT
 SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32_t set, std::uint32_t model,
                       const BrdfParams& params, vec3 v, std::uint32_t n, std::uint32_t seed, std::uint32_t strategy,
                       const sampling::TabulatedTables* tab, bool warmUp, std::uint32_t timingRepeats,
-                      std::uint32_t timingCount) {
+                      std::uint32_t timingCount, const RoughnessBins* bins) {
   if (strategy == SAMPLER_TABULATED && !tab) throw std::invalid_argument("sampleGpu: tabulated needs its tables");
   SampleBatch out;
   auto upload = [&](const void* data, std::size_t bytes, const char* what) {
@@ -105,7 +105,7 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
     return b;
   };
   GpuMaterial mat{};
-  mat.info = uvec4(model, 0u, set, 0u);
+  mat.info = uvec4(model, bins ? MATERIAL_BINNED : 0u, set, 0u);
   mat.params = params;
   // A measured table goes to the GPU as table 0 of the measured buffer.
   const bool measured = model == MODEL_MERL;
@@ -141,13 +141,15 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
   g.tabTables = tTables.address;
   g.tabData = tData.address;
   g.measured = measuredTables.address;
+  if (bins) g.roughnessBins = *bins;
 
   // Binding 0 = the Globals block, as the renderer's stages.
   std::memcpy(globals.mapped, &g, sizeof g);
   vk::GlobalsBinding binding = vk::createGlobalsBinding(ctx, globals.buffer, STAGE_PUSH_BYTES);
   VkPipelineLayout layout = binding.layout;
   VkDescriptorSet dset = binding.set;
-  vk::ComputePipeline pipe = vk::createComputePipeline(ctx, layout, "sample_tool", {model, strategy});
+  vk::ComputePipeline pipe = bins ? vk::createComputePipeline(ctx, layout, "sample_tool", {model, strategy, 1u})
+                                  : vk::createComputePipeline(ctx, layout, "sample_tool", {model, strategy});
 
   SampleToolConstants pc{};
   pc.seed = seed;

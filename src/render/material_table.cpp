@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "../../shaders/shared/brdf/dispatch.h"
+#include "../../shaders/shared/bsdf_sampling.h"
 #include "../../shaders/shared/layout.h"
 #include "brdf/albedo.h"
 #include "brdf/merl.h"
@@ -108,12 +109,32 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
   constexpr int kInsideUse = -2;
   std::vector<std::pair<std::uint32_t, shared::BrdfParams>> toBuild;
   std::vector<TableUse> uses;
+  // Binned sampling: gltf_pbr materials whose textures vary their parameters share K sets of the
+  // pure specular lobe (binParams at binRoughness), built first so that they are sets 0 .. K - 1
+  // (buildSamplerTables numbers distinct parameter blocks in order of first use).
+  auto binnedMaterial = [&](std::size_t i) {
+    const Material& m = scene.materials[i];
+    return used[i] && settings.sampler == SamplerKind::Quadtree && settings.roughnessBins >= 2 && !m.combined() &&
+           m.model == MODEL_GLTF_PBR && textureUse(m, scene).paramsVary();
+  };
+  bool anyBinned = false;
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) anyBinned = anyBinned || binnedMaterial(i);
+  if (anyBinned) {
+    if (!(settings.roughnessBinSpacing > 0.0f) || !std::isfinite(settings.roughnessBinSpacing))
+      throw Error("the roughness bins' spacing must be a positive number");
+    m_bins = shared::RoughnessBins{0u, settings.roughnessBins, settings.roughnessBinSpacing, 0u};
+    for (std::uint32_t j = 0; j < settings.roughnessBins; ++j) {
+      toBuild.push_back({MODEL_GLTF_PBR, shared::binParams(shared::binRoughness(m_bins, j))});
+      uses.push_back({INVALID_INDEX, static_cast<int>(j)});
+    }
+  }
   if (settings.sampler == SamplerKind::Quadtree || settings.sampler == SamplerKind::Tabulated)
     for (std::size_t i = 0; i < scene.materials.size(); ++i) {
       if (!used[i]) continue;
       const Material& m = scene.materials[i];
-      // A texture that varies the BRDF's parameters over the surface: no one table fits, the
-      // strategy falls back to cosine (INVALID_INDEX; docs/scenes.md, "Textures").
+      // A texture that varies the BRDF's parameters over the surface: no one table fits
+      // (INVALID_INDEX): gltf_pbr under the quadtree samples the roughness bins above
+      // (MATERIAL_BINNED), the rest falls back to cosine (docs/scenes.md, "Sampling textured materials").
       if (!m.combined() && !modelById(m.model).delta && !textureUse(m, scene).paramsVary()) {
         toBuild.push_back({m.model, m.params});
         uses.push_back({static_cast<std::uint32_t>(i), -1});
@@ -143,6 +164,7 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     m_plan.bytes = tab.bytes();
   } else if (!toBuild.empty()) {
     quadtree::QuadtreeSettings qs;
+    // The bins' trees are looked up at any texel's wo: full tables (the settings' counts).
     qs.thetaTables = std::max(1u, settings.samplerThetaTables);
     qs.phiTables = std::max(2u, settings.samplerPhiTables);
     qt = quadtree::buildSamplerTables(toBuild, qs, setOf);
@@ -152,6 +174,13 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     m_plan.cacheHits = qt.cacheHits;
     m_plan.cacheMisses = qt.cacheMisses;
     m_plan.cacheRejected = qt.cacheRejected;
+  }
+  if (anyBinned) {
+    for (std::uint32_t j = 0; j < m_bins.count; ++j)
+      if (setOf[j] != j) throw Error("internal: the roughness bins are not the first quadtree sets");
+    m_plan.roughnessBins = m_bins.count;
+    for (const quadtree::MaterialStats& st : qt.materials)
+      if (st.set < m_bins.count) m_plan.binBytes += st.bytes;
   }
   // The set of each material and component: the quadtree's QuadSet or the tabulated TabSet (the
   // shade stage passes it to bsdfSample as the set of the strategy it is specialised for).
@@ -193,6 +222,7 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     if (used[i] && textureUse(src, scene).any()) flags |= MATERIAL_TEXTURED;
     if (used[i] && textureUse(src, scene).alpha) flags |= MATERIAL_ALPHA;
     if (src.absorbs()) flags |= MATERIAL_ABSORBING;
+    if (binnedMaterial(i)) flags |= MATERIAL_BINNED;
     const std::uint32_t material = static_cast<std::uint32_t>(i);
     dst.info = glm::uvec4(src.combined() ? src.components[0].model : src.model, flags,
                           src.combined() ? INVALID_INDEX : setFor(material, -1), slot);
@@ -285,6 +315,7 @@ void MaterialTable::fillGlobals(shared::Globals& g) const {
   g.texturedScene = m_textured ? 1u : 0u;
   g.alphaScene = m_alpha ? 1u : 0u;
   g.materialCount = static_cast<std::uint32_t>(std::max<std::size_t>(m_materialCount, 1));
+  g.roughnessBins = m_bins;
 }
 
 }  // namespace nusselt

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "../../shaders/shared/quadtree_layout.h"
 #include "render/settings.h"
 #include "scene/scene.h"
 #include "vk/vk.h"
@@ -25,6 +26,10 @@ struct SamplerPlanSummary {
   std::uint32_t tables = 0;
   std::uint64_t bytes = 0;
   std::uint32_t cacheHits = 0, cacheMisses = 0, cacheRejected = 0;
+  // Binned sampling (RenderSettings::roughnessBins): the bins built (0: the scene has no material
+  // that needs them, or no bins) and their sets' bytes (included in bytes).
+  std::uint32_t roughnessBins = 0;
+  std::uint64_t binBytes = 0;
 };
 
 class MaterialTable {
@@ -58,6 +63,7 @@ class MaterialTable {
   vk::Buffer m_quadSets, m_quadTables, m_quadNodes, m_quadLeaves;
   vk::Buffer m_tabSets, m_tabTables, m_tabData;
   vk::Buffer m_measured;  // measured BRDF tables (merl), MERL_TABLE_FLOATS floats each
+  shared::RoughnessBins m_bins{0u, 0u, 1.0f, 0u};  // Globals.roughnessBins
   bool m_textured = false;  // some used material has a texture that applies, or alpha
   bool m_alpha = false;     // some used material has alphaMode MASK or BLEND
   vk::Buffer m_textures, m_texels, m_materialTextures;  // texture_table.h; one entry each without textures

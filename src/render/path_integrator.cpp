@@ -94,6 +94,8 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   // Texture code only in the shade stages of a scene with textures (the material table set it).
   m_hasTextures = g.texturedScene != 0u;
   m_hasAlpha = g.alphaScene != 0u;
+  // Binned sampling code only in the shade stages of a scene with binned materials (constant 12).
+  m_hasBins = g.roughnessBins.count > 0u;
 
   auto t0 = std::chrono::steady_clock::now();
   createPipelines();
@@ -187,11 +189,14 @@ void PathIntegrator::createPipelines() {
           spec.resize(7, 0u);
           spec.push_back(m_hasEscape ? 1u : 0u);
           spec.push_back(m_hasTextures ? 1u : 0u);  // constant 8: HAS_TEXTURES
-          if (guiding || primary) {
+          if (guiding || primary || m_hasBins) {
             spec.push_back(0u);       // constant 9: HAS_ALPHA (tracing stages only)
             spec.push_back(guiding);  // constant 10: GUIDING
             spec.push_back(primary);  // constant 11: PRIMARY_SAMPLES
           }
+          // Constant 12: HAS_BINS (single-model quadtree modules with the scene features; binned
+          // materials are textured, so the module is an _f one).
+          if (m_hasBins) spec.push_back(1u);
           // One module per strategy (CMakeLists.txt): shade_sN / shade_combined_sN, and _f with the
           // texture and guiding code for the scenes and renders that use them.
           // Single-model materials under the quadtree strategy have a module per model,

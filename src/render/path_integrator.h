@@ -112,6 +112,7 @@ class PathIntegrator : public Integrator {
   bool m_hasEscape = false;
   bool m_hasTextures = false;  // spec constant HAS_TEXTURES of the shade stages
   bool m_hasAlpha = false;     // spec constant HAS_ALPHA of the tracing stages
+  bool m_hasBins = false;      // spec constant HAS_BINS of the shade stages (binned sampling)
   DeviceGuide* m_guide = nullptr;  // path guiding (guide.h): its records are read after every chunk
   vk::Buffer* m_pathRadiance = nullptr;
   vk::Buffer* m_pathInfo = nullptr;

@@ -94,6 +94,11 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
                   {"nusselt/envScale", r.envScale},
                   {"nusselt/envRotate", r.envRotate}};
   if (r.timeBudget > 0) meta.doubles.push_back({"nusselt/timeBudget", r.timeBudget});
+  // Binned sampling (written only when the scene used bins: other headers are as before).
+  if (r.roughnessBins > 0) {
+    meta.ints.push_back({"nusselt/roughnessBins", r.roughnessBins});
+    meta.doubles.push_back({"nusselt/roughnessBinSpacing", r.settings.roughnessBinSpacing});
+  }
   // Path guiding (written only when on: unguided headers are as before).
   if (r.settings.guiding) {
     meta.strings.push_back({"nusselt/guiding", "on"});
@@ -197,6 +202,11 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   r.environment = findString(meta, "nusselt/environment").value_or("none");
   r.envScale = findDouble(meta, "nusselt/envScale").value_or(1);
   r.envRotate = findDouble(meta, "nusselt/envRotate").value_or(0);
+  r.roughnessBins = static_cast<std::uint32_t>(findInt(meta, "nusselt/roughnessBins").value_or(0));
+  if (r.roughnessBins > 0) {
+    r.settings.roughnessBins = r.roughnessBins;
+    r.settings.roughnessBinSpacing = static_cast<float>(findDouble(meta, "nusselt/roughnessBinSpacing").value_or(1));
+  }
   r.envSelect = findString(meta, "nusselt/envSelect").value_or("half");
   // Absent in path-traced renders (and files written before other integrators existed).
   if (!parseIntegrator(findString(meta, "nusselt/integratorName").value_or("path"), r.settings.integrator))
@@ -248,6 +258,13 @@ std::string firstDifference(const RenderRecord& a, const RenderRecord& b) {
         differ("the lighting (--lighting)", lightingModeName(s.lighting), lightingModeName(t.lighting)),
         differ("the random numbers (--rng)", rngModeName(s.rng), rngModeName(t.rng)),
         differ("the sampler (--sampler)", samplerName(s.sampler), samplerName(t.sampler)),
+        // Compared when either used bins (a render about to resume has not built its bins yet:
+        // its settings say what it will build).
+        differ("the roughness bins (--roughness-bins, --roughness-bin-spacing)",
+               a.roughnessBins || b.roughnessBins
+                   ? std::to_string(s.roughnessBins) + " spaced " + number(s.roughnessBinSpacing) : "",
+               a.roughnessBins || b.roughnessBins
+                   ? std::to_string(t.roughnessBins) + " spaced " + number(t.roughnessBinSpacing) : ""),
         differ("the component selection (--components)", componentSelectionName(s.components),
                componentSelectionName(t.components)),
         differ("the roulette (--roulette)", rouletteModeName(s.roulette), rouletteModeName(t.roulette)),

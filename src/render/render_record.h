@@ -36,6 +36,9 @@ struct RenderRecord {
   // Path guiding: the hash of the guide the render sampled from when it was written
   // (DeviceGuide::hash, 16 hex digits); empty for unguided renders and older files.
   std::string guideHash;
+  // Binned sampling (settings.roughnessBins, roughnessBinSpacing): the bins the render built, 0 when
+  // its scene has no material that needs them (then the header has no bin attributes).
+  std::uint32_t roughnessBins = 0;
 };
 
 // The record's description of an environment ("none", "uniform R,G,B", "map FILE"); a scene's

@@ -154,6 +154,8 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   m_summary.samplerCacheHits = plan.cacheHits;
   m_summary.samplerCacheMisses = plan.cacheMisses;
   m_summary.samplerCacheRejected = plan.cacheRejected;
+  m_summary.roughnessBins = plan.roughnessBins;
+  m_summary.binBytes = plan.binBytes;
   m_film = std::make_unique<Film>(m_ctx, settings.width, settings.height);
 
   Globals& g = m_globals->host();

@@ -136,6 +136,12 @@ struct RenderSettings {
   // a looser fit between tables, more variance (never bias).
   std::uint32_t samplerThetaTables = 90;
   std::uint32_t samplerPhiTables = 16;
+  // Binned sampling of gltf_pbr materials whose textures vary their parameters (quadtree strategy;
+  // shaders/shared/bsdf_sampling.h, "Binned sampling"; docs/scenes.md, "Sampling textured
+  // materials"): the number of roughness bins K (0: no bins, such materials sample the cosine) and
+  // their spacing, r_j = (j / (K - 1))^spacing. Defaults from `nusselt bench bins`.
+  std::uint32_t roughnessBins = 16;
+  float roughnessBinSpacing = 2.0f;
   // Sample indices of this render start here (`--spp-offset`): a frame can be split across
   // machines into disjoint sample ranges and merged (`nusselt merge`).
   std::uint32_t sampleOffset = 0;

@@ -26,6 +26,20 @@ attr() { "$nusselt" info "$1" | sed -n "s/^  nusselt\/$2: //p"; }
 [ "$(attr "$work/a.exr" samplerBoundViolations)" = 0 ] || fail "samplerBoundViolations attribute"
 [ -n "$(attr "$work/a.exr" samplerTrialFailures)" ] || fail "samplerTrialFailures attribute"
 "$nusselt" info "$work/a.exr" | head -1 | grep -q "16x12" || fail "image size"
+# Binned sampling (docs/scenes.md, "Sampling textured materials"): recorded only when the scene used
+# bins (the default scene has no textured gltf_pbr); a resume with other bins is refused.
+[ -z "$(attr "$work/a.exr" roughnessBins)" ] || fail "roughnessBins attribute without bins"
+"$nusselt" render "$2/scenes/tests/textures.gltf" -o "$work/t.exr" --width 16 --height 12 --spp 2 --roughness-bins 4 \
+  --roughness-bin-spacing 1.5 -q || fail "textured render exit $?"
+[ "$(attr "$work/t.exr" roughnessBins)" = 4 ] || fail "roughnessBins attribute: '$(attr "$work/t.exr" roughnessBins)'"
+[ "$(attr "$work/t.exr" roughnessBinSpacing)" = 1.5 ] || fail "roughnessBinSpacing attribute: '$(attr "$work/t.exr" roughnessBinSpacing)'"
+if "$nusselt" render "$2/scenes/tests/textures.gltf" -o "$work/t2.exr" --width 16 --height 12 --spp 3 --resume "$work/t.exr" \
+  --roughness-bins 8 --roughness-bin-spacing 1.5 -q 2>"$work/resume_err"; then
+  fail "a resume with other roughness bins was accepted"
+fi
+grep -q "roughness bins" "$work/resume_err" || fail "resume error does not name the bins: $(cat "$work/resume_err")"
+"$nusselt" render "$2/scenes/tests/textures.gltf" -o "$work/t3.exr" --width 16 --height 12 --spp 3 --resume "$work/t.exr" \
+  --roughness-bins 4 --roughness-bin-spacing 1.5 -q || fail "a resume with the same bins was refused"
 
 # Same seed: identical pixels (the header differs only in timings).
 "$nusselt" render -o "$work/b.exr" --width 16 --height 12 --spp 3 --seed 9 --max-depth 5 -q
