@@ -197,6 +197,11 @@ int renderCommand(const RenderArgs& a) {
       if (p.guideMemory != s.guideMemory)
         refuse("--guide-memory", formatNumber(p.guideMemory / 1048576.0) + " MiB",
                formatNumber(s.guideMemory / 1048576.0) + " MiB");
+      auto box = [](bool on) { return std::string(on ? "box" : "none"); };
+      if (p.guideDirFilter != s.guideDirFilter) refuse("--guide-filter", box(p.guideDirFilter), box(s.guideDirFilter));
+      if (p.guideSpatialFilter != s.guideSpatialFilter)
+        refuse("--guide-spatial-filter", box(p.guideSpatialFilter), box(s.guideSpatialFilter));
+      if (p.guideFloor != s.guideFloor) refuse("--guide-floor", formatNumber(p.guideFloor), formatNumber(s.guideFloor));
       s.guideTrainSpp = base.settings.guideTrainSpp = p.guideTrainSpp;
       s.guideTrainPass = base.settings.guideTrainPass = p.guideTrainPass;  // the passes it trained in
     }

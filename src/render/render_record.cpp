@@ -262,9 +262,9 @@ std::string firstDifference(const RenderRecord& a, const RenderRecord& b) {
         // its settings say what it will build).
         differ("the roughness bins (--roughness-bins, --roughness-bin-spacing)",
                a.roughnessBins || b.roughnessBins
-                   ? std::to_string(s.roughnessBins) + " spaced " + number(s.roughnessBinSpacing) : "",
+                   ? std::to_string(s.roughnessBins) + " spaced " + formatNumber(s.roughnessBinSpacing) : "",
                a.roughnessBins || b.roughnessBins
-                   ? std::to_string(t.roughnessBins) + " spaced " + number(t.roughnessBinSpacing) : ""),
+                   ? std::to_string(t.roughnessBins) + " spaced " + formatNumber(t.roughnessBinSpacing) : ""),
         differ("the component selection (--components)", componentSelectionName(s.components),
                componentSelectionName(t.components)),
         differ("the roulette (--roulette)", rouletteModeName(s.roulette), rouletteModeName(t.roulette)),
