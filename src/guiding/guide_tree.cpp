@@ -14,44 +14,11 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 // ---- Directional quadtree -------------------------------------------------------------------------
 
 void DirTree::splat(glm::vec2 p, double value) {
-  // The same cell geometry as guideSquarePdf (dyadic, exact in floats).
-  std::uint32_t node = 0;
-  float x0 = 0.0f, y0 = 0.0f, size = 1.0f;
-  for (std::uint32_t d = 0; d <= GUIDE_MAX_DIR_DEPTH; ++d) {
-    size *= 0.5f;
-    std::uint32_t c = 0;
-    if (p.x >= x0 + size) {
-      c += 1;
-      x0 += size;
-    }
-    if (p.y >= y0 + size) {
-      c += 2;
-      y0 += size;
-    }
-    m_nodes[node].energy[c] += value;
-    if (m_nodes[node].child[c] == 0) return;
-    node = m_nodes[node].child[c];
-  }
+  descend(p, [&](std::uint32_t node, std::uint32_t c) { m_nodes[node].energy[c] += value; });
 }
 
 double DirTree::leafSide(glm::vec2 p) const {
-  std::uint32_t node = 0;
-  float x0 = 0.0f, y0 = 0.0f, size = 1.0f;
-  for (std::uint32_t d = 0; d <= GUIDE_MAX_DIR_DEPTH; ++d) {
-    size *= 0.5f;
-    std::uint32_t c = 0;
-    if (p.x >= x0 + size) {
-      c += 1;
-      x0 += size;
-    }
-    if (p.y >= y0 + size) {
-      c += 2;
-      y0 += size;
-    }
-    if (m_nodes[node].child[c] == 0) break;
-    node = m_nodes[node].child[c];
-  }
-  return size;
+  return descend(p, [](std::uint32_t, std::uint32_t) {});
 }
 
 void DirTree::splatBox(glm::vec2 p, double side, double value) {

@@ -109,6 +109,29 @@ class DirTree {
   std::uint32_t depth() const;
 
  private:
+  // The descent to p's leaf, the same cell geometry as guideSquarePdf (dyadic, exact in floats):
+  // visit(node, child) at every level, the leaf's last; returns the leaf cell's side.
+  template <class Visit>
+  double descend(glm::vec2 p, Visit&& visit) const {
+    std::uint32_t node = 0;
+    float x0 = 0.0f, y0 = 0.0f, size = 1.0f;
+    for (std::uint32_t d = 0; d <= GUIDE_MAX_DIR_DEPTH; ++d) {
+      size *= 0.5f;
+      std::uint32_t c = 0;
+      if (p.x >= x0 + size) {
+        c += 1;
+        x0 += size;
+      }
+      if (p.y >= y0 + size) {
+        c += 2;
+        y0 += size;
+      }
+      visit(node, c);
+      if (m_nodes[node].child[c] == 0) break;
+      node = m_nodes[node].child[c];
+    }
+    return size;
+  }
   void splatBoxInto(std::uint32_t node, double x0, double y0, double size, double bx0, double bx1, double by0,
                     double by1, double valuePerArea);
   std::vector<Node> m_nodes;
