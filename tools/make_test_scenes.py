@@ -30,6 +30,10 @@
   glass_slab_tinted.gltf  glass_slab.gltf's slab with KHR_materials_volume attenuationColor
                  (0.8, 0.5, 0.2) at attenuationDistance 0.2 (= its thickness): at normal incidence
                  the emitter converges to (1 - R)^2 c / (1 - R^2 c^2) per channel.
+  glass_slab_base_color.gltf  glass_slab.gltf's slab with baseColorFactor (0.8, 0.5, 0.2), which
+                 tints the light it transmits at each of its two faces (KHR_materials_transmission's
+                 tinting; KHR_materials_volume: a coloured foil on the boundary): at normal
+                 incidence the emitter converges to c^2 (1 - R) / (1 + R) per channel.
   guiding_gap.gltf  two rooms (4 x 2 x 2, Lambert rho 0.7) divided by a wall at x = 0 with a
                  0.3 x 0.3 opening at its centre; the area light is on the ceiling of the left room,
                  the camera in the right one: the right room sees light only through the opening
@@ -419,14 +423,17 @@ def textures():
     b.write("textures.gltf")
 
 
-def slab_scene(material, volume, filename):
+def slab_scene(material, volume, filename, base_color=None):
     """A lamp at z = 0 seen through a slab of `material` between z = 0.2 and 0.4 (its
-    KHR_materials_volume: `volume`)."""
+    KHR_materials_volume: `volume`; its baseColorFactor `base_color`, default white)."""
     b = Builder()
     b.use("KHR_materials_transmission")
     b.use("KHR_materials_ior")
     b.use("KHR_materials_volume")
-    glass = b.pbr_material(material, {"metallicFactor": 0.0, "roughnessFactor": 0.0},
+    pbr = {"metallicFactor": 0.0, "roughnessFactor": 0.0}
+    if base_color is not None:
+        pbr["baseColorFactor"] = list(base_color) + [1.0]
+    glass = b.pbr_material(material, pbr,
                            extensions={"KHR_materials_transmission": {"transmissionFactor": 1.0},
                                        "KHR_materials_ior": {"ior": 1.5},
                                        "KHR_materials_volume": volume})
@@ -448,6 +455,11 @@ def glass_slab_tinted():
     # attenuationColor.
     slab_scene("tinted", {"thicknessFactor": 0.2, "attenuationDistance": 0.2,
                           "attenuationColor": [0.8, 0.5, 0.2]}, "glass_slab_tinted.gltf")
+
+
+def glass_slab_base_color():
+    # The base colour tints each crossing of the boundary (both faces).
+    slab_scene("coloured", {"thicknessFactor": 0.2}, "glass_slab_base_color.gltf", base_color=(0.8, 0.5, 0.2))
 
 
 def guiding_gap():
@@ -481,4 +493,5 @@ if __name__ == "__main__":
     textures()
     glass_slab()
     glass_slab_tinted()
+    glass_slab_base_color()
     guiding_gap()

@@ -41,28 +41,51 @@ float componentMisPdf(uint model, GpuComponent C, float c, vec3 wo, vec3 wi) {
 }
 #endif
 
-// ---- evalParams: the material's parameters at the hit (textures; docs/scenes.md, "Textures") ----
-// params: the model's parameters (the material's factors on entry); emission: its emitted
-// radiance. gltf_pbr: baseColor x baseColorTexture.rgb (sRGB decoded), metallic x B and roughness
-// x G of metallicRoughnessTexture; any model: emission x emissiveTexture.rgb (sRGB decoded).
+// ---- The material's parameters at the hit (textures; docs/scenes.md, "Textures") ----
+// texturedParams: a model's parameters (its factors on entry) under the base-colour texture's RGB
+// `base` and the metallic-roughness texture's B, G (`mr`; 1 where the material has none): gltf_pbr's
+// baseColor x base, metallic x mr.x, roughness x mr.y; a transmitting model's tint x base (glTF's
+// tinted transmission); other models unchanged. Used for the material itself and for each
+// component of a combined one.
+void texturedParams(uint model, vec3 base, vec2 mr, inout BrdfParams params) {
+  if (model == MODEL_GLTF_PBR) {
+    for (uint k = 0u; k < 3u; ++k) params.v[(GLTF_PBR_BASE_COLOR + k) / 4u][(GLTF_PBR_BASE_COLOR + k) % 4u] *= base[k];
+    params.v[GLTF_PBR_METALLIC / 4u][GLTF_PBR_METALLIC % 4u] *= mr.x;
+    params.v[GLTF_PBR_ROUGHNESS / 4u][GLTF_PBR_ROUGHNESS % 4u] *= mr.y;
+  }
+  uint tint = model == MODEL_DIELECTRIC        ? DIELECTRIC_TINT
+              : model == MODEL_THIN_DIELECTRIC  ? THIN_DIELECTRIC_TINT
+              : model == MODEL_ROUGH_DIELECTRIC ? ROUGH_DIELECTRIC_TINT
+                                                : INVALID_INDEX;
+  if (tint != INVALID_INDEX)
+    for (uint k = 0u; k < 3u; ++k) params.v[(tint + k) / 4u][(tint + k) % 4u] *= base[k];
+}
+
 #if NUSSELT_SCENE_FEATURES
+// The base-colour texture's RGB (sRGB decoded) and the metallic-roughness texture's (B, G) at the
+// hit, 1 where the material has none (texture_table.cpp applies them to gltf_pbr and the
+// transmitting models only: MaterialTextureUse).
+void materialTexels(uint material, uint tri, float b1, float b2, out vec3 base, out vec2 mr) {
+  GpuMaterialTextures T = g.materialTextures.v[material];
+  GpuTriTexcoords uv = g.texcoords.v[tri];
+  base = vec3(1.0f);
+  mr = vec2(1.0f);
+  if (T.maps.x != INVALID_INDEX) base = textureAtHit(texelBuffer(), g.textures.v[T.maps.x], uv, b1, b2).xyz;
+  if (T.maps.y != INVALID_INDEX) mr = textureAtHit(texelBuffer(), g.textures.v[T.maps.y], uv, b1, b2).zy;
+}
+
+// evalParams: params (the model's factors on entry) and emission at the hit; any model's emission
+// x emissiveTexture.rgb (sRGB decoded); model INVALID_INDEX (a combined material, whose components
+// shadeMaterial textures): the emission only.
 void evalParams(uint model, uint material, uint tri, float b1, float b2, inout BrdfParams params,
                 inout vec3 emission) {
   GpuMaterialTextures T = g.materialTextures.v[material];
-  GpuTriTexcoords uv = g.texcoords.v[tri];
-  if (T.maps.z != INVALID_INDEX) emission *= textureAtHit(texelBuffer(), g.textures.v[T.maps.z], uv, b1, b2).xyz;
-  if (model == MODEL_GLTF_PBR) {
-    if (T.maps.x != INVALID_INDEX) {
-      vec4 c = textureAtHit(texelBuffer(), g.textures.v[T.maps.x], uv, b1, b2);
-      for (uint k = 0u; k < 3u; ++k)
-        params.v[(GLTF_PBR_BASE_COLOR + k) / 4u][(GLTF_PBR_BASE_COLOR + k) % 4u] *= c[k];
-    }
-    if (T.maps.y != INVALID_INDEX) {
-      vec4 mr = textureAtHit(texelBuffer(), g.textures.v[T.maps.y], uv, b1, b2);
-      params.v[GLTF_PBR_METALLIC / 4u][GLTF_PBR_METALLIC % 4u] *= mr.z;
-      params.v[GLTF_PBR_ROUGHNESS / 4u][GLTF_PBR_ROUGHNESS % 4u] *= mr.y;
-    }
-  }
+  if (T.maps.z != INVALID_INDEX) emission *= textureAtHit(texelBuffer(), g.textures.v[T.maps.z], g.texcoords.v[tri], b1, b2).xyz;
+  if (model == INVALID_INDEX || (T.maps.x == INVALID_INDEX && T.maps.y == INVALID_INDEX)) return;
+  vec3 base;
+  vec2 mr;
+  materialTexels(material, tri, b1, b2, base, mr);
+  texturedParams(model, base, mr, params);
 }
 
 // ---- The normal map (docs/scenes.md, "Normal maps") ----
@@ -126,10 +149,21 @@ float transmissionAt(uint material, uint tri, float b1, float b2) {
 // A module without textures (NUSSELT_SCENE_FEATURES 0, stage_common.glsl): empty stand-ins.
 void evalParams(uint model, uint material, uint tri, float b1, float b2, inout BrdfParams params,
                 inout vec3 emission) {}
+void materialTexels(uint material, uint tri, float b1, float b2, out vec3 base, out vec2 mr) {
+  base = vec3(1.0f);
+  mr = vec2(1.0f);
+}
 vec3 normalMapped(uint material, uint tri, float b1, float b2, vec3 ns, vec3 ngFront) { return ns; }
 float transmissionAt(uint material, uint tri, float b1, float b2) { return -1.0f; }
 #endif
 
+
+// Where a ray hit: the material, the triangle and the barycentrics (texture lookups).
+struct ShadeHit {
+  uint material;
+  uint tri;
+  float b1, b2;
+};
 
 // One step of the walk as the material's sampler drew it: the local direction, the factor the
 // throughput is multiplied by (weight, divided by the choice and albedo-roulette probabilities),
@@ -177,7 +211,8 @@ struct ShadeMaterial {
 // seen from the inside (transmissionInsideParams: eta -> 1 / eta) and their sampler tables
 // (GpuMaterial.components.z), as the smooth dielectric takes 1 / eta there (dielectric.h).
 // The guide is off for transmitting models (alpha = 0): its mixture covers the upper hemisphere only.
-ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, float transmissionR, bool inside) {
+// hit: unused (evalParams textured M's parameters before).
+ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, ShadeHit hit, bool inside) {
   ShadeMaterial m;
   m.M = M;
   if (modelTransmits(MODEL_ID) && inside) {
@@ -286,9 +321,11 @@ struct ShadeMaterial {
   bool lightSamples; // no delta flag on the material
 };
 
-// transmissionR: the transmission texture's R at the hit (transmissionAt), or -1. inside: unused
-// (only delta components transmit here; the renderer refuses transmitting non-delta components).
-ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, float transmissionR, bool inside) {
+// hit: a textured material's components take the textures at the hit (texturedParams: gltf_pbr's
+// base colour and metallic-roughness, the transmitting models' tint), and the transmission
+// texture's R (transmissionAt) sets the weights below. inside: unused (only delta components
+// transmit here; the renderer refuses transmitting non-delta components).
+ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, ShadeHit hit, bool inside) {
   ShadeMaterial m;
   m.a = vec4(0.0f);
   uint first = M.components.x;
@@ -297,6 +334,17 @@ ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, float
   if (COMPONENT_COUNT > 1u) m.C1 = g.components.v[first + 1u];
   if (COMPONENT_COUNT > 2u) m.C2 = g.components.v[first + 2u];
   if (COMPONENT_COUNT > 3u) m.C3 = g.components.v[first + 3u];
+  float transmissionR = -1.0f;
+  if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) {
+    transmissionR = transmissionAt(hit.material, hit.tri, hit.b1, hit.b2);
+    vec3 base;
+    vec2 mr;
+    materialTexels(hit.material, hit.tri, hit.b1, hit.b2, base, mr);
+    if (COMPONENT_COUNT > 0u) texturedParams(MODEL_0, base, mr, m.C0.params);
+    if (COMPONENT_COUNT > 1u) texturedParams(MODEL_1, base, mr, m.C1.params);
+    if (COMPONENT_COUNT > 2u) texturedParams(MODEL_2, base, mr, m.C2.params);
+    if (COMPONENT_COUNT > 3u) texturedParams(MODEL_3, base, mr, m.C3.params);
+  }
   // The transmission combination {gltf_pbr, 1 - w; glass, w} under a transmission texture: the
   // glass takes w R at this hit, gltf_pbr the rest (Material::transmissionTextured).
   if (COMPONENT_COUNT == 2u && transmissionR >= 0.0f) {
@@ -541,11 +589,7 @@ void main() {
   vec3 xo = offsetRay(x, ng);
   bool last = bounce >= g.maxDepth;
 
-  float transmissionR = -1.0f;  // the transmission texture at the hit (combined materials only)
-#if SHADE_COMBINED
-  if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) transmissionR = transmissionAt(S.info.x, tri, hit.y, hit.z);
-#endif
-  ShadeMaterial m = shadeMaterial(M, x, wo, roulette, transmissionR, !frontFace);
+  ShadeMaterial m = shadeMaterial(M, x, wo, roulette, ShadeHit(S.info.x, tri, hit.y, hit.z), !frontFace);
   if (!last && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m))
     nextEvent(m, path, key, bounce, lighting, x, xo, ng, tt, bb, ns, wo, beta);
 

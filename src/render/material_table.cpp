@@ -145,8 +145,10 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
           uses.push_back({static_cast<std::uint32_t>(i), kInsideUse});
         }
       }
+      // A textured gltf_pbr component has no table either: cosine (MaterialTextureUse::paramsVary).
+      const bool pbrVaries = textureUse(m, scene).paramsVary();
       for (std::size_t k = 0; k < m.components.size(); ++k)
-        if (!modelById(m.components[k].model).delta) {
+        if (!modelById(m.components[k].model).delta && !(pbrVaries && m.components[k].model == MODEL_GLTF_PBR)) {
           toBuild.push_back({m.components[k].model, m.components[k].params});
           uses.push_back({static_cast<std::uint32_t>(i), static_cast<int>(k)});
         }

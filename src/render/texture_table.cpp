@@ -15,9 +15,10 @@ using shared::GpuTexture;
 
 MaterialTextureUse textureUse(const Material& m, const Scene& scene) {
   MaterialTextureUse u;
-  const bool pbr = !m.combined() && m.model == MODEL_GLTF_PBR;
-  u.baseColor = pbr && m.baseColorTexture.present();
+  const bool pbr = m.hasGltfPbr();
+  u.baseColor = (pbr || m.hasTintedTransmission()) && m.baseColorTexture.present();
   u.metallicRoughness = pbr && m.metallicRoughnessTexture.present();
+  u.pbrVaries = pbr && (m.baseColorTexture.present() || m.metallicRoughnessTexture.present());
   u.emissive = m.emits() && m.emissiveTexture.present();
   u.alpha = m.alphaMode != AlphaMode::Opaque;
   u.transmission = m.transmissionTextured && m.transmissionTexture.present() && m.components.size() == 2;
@@ -158,7 +159,8 @@ TextureData buildTextureData(const Scene& scene) {
       case SlotCoverage: g.alpha.y = index; break;
       case SlotTransmission: g.transmission.x = index; break;
     }
-    // Coverage: the base-colour texture's alpha, for any model (its RGB applies to gltf_pbr only).
+    // Coverage: the base-colour texture's alpha, for any model (its RGB applies to gltf_pbr and
+    // the transmitting models only).
     if (slot == SlotBaseColor && textureUse(scene.materials[i], scene).alpha) g.alpha.y = index;
   });
   return d;

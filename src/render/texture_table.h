@@ -13,16 +13,22 @@ namespace nusselt {
 
 // The textures of a material that the shade stage applies.
 struct MaterialTextureUse {
-  bool baseColor = false;          // gltf_pbr materials (single-model): baseColor x baseColorFactor
-  bool metallicRoughness = false;  // gltf_pbr: G x roughnessFactor, B x metallicFactor
+  // baseColor: RGB x baseColor of a gltf_pbr material or component, and x tint of a transmitting
+  // one (dielectric, thin_dielectric, rough_dielectric: glTF's tinted transmission).
+  bool baseColor = false;
+  bool metallicRoughness = false;  // gltf_pbr material or component: G x roughness, B x metallic
   bool emissive = false;           // any material with a non-zero emission: RGB x emission
   bool normal = false;             // any material: the shading normal (needs Scene::tangents)
   bool alpha = false;              // any material: alphaMode MASK or BLEND (coverage in traversal)
   bool transmission = false;       // the transmission combination (Material::transmissionTextured)
   bool any() const { return baseColor || metallicRoughness || emissive || normal || alpha || transmission; }
-  // The BRDF's parameters (not only its emission) vary over the surface: no per-material
-  // sampling tables fit it (the quadtree and tabulated samplers fall back to cosine).
-  bool paramsVary() const { return baseColor || metallicRoughness; }
+  // A gltf_pbr material or component whose BRDF's shape varies over the surface (a textured
+  // base colour or metallic-roughness): no one sampling table fits it (a single gltf_pbr samples
+  // the roughness bins under the quadtree, a component and the rest fall back to cosine). A
+  // texture that tints a transmitting model does not count: its tables (for the factors) still
+  // cover every direction the textured BSDF scatters to, so they stay an unbiased proposal.
+  bool pbrVaries = false;
+  bool paramsVary() const { return pbrVaries; }
 };
 // scene: for the normal map, which needs the scene's tangents (Scene::tangents per corner).
 MaterialTextureUse textureUse(const Material& m, const Scene& scene);

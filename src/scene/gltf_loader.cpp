@@ -1343,6 +1343,10 @@ class Converter {
     // A transmission texture varies w over the surface: the combination even where w = 1.
     const bool textured = m.transmissionTexture.present();
     const float r = m.roughnessFactor;
+    // The extension's tint: the base colour (baseColorFactor, times its texture at the hit:
+    // shade_body.glsl) colours the transmitted light at every crossing of the surface.
+    const ParamValue tint = arrayValue({ParamValue::num(m.baseColorFactor[0]), ParamValue::num(m.baseColorFactor[1]),
+                                        ParamValue::num(m.baseColorFactor[2])});
     if (r > 0.0f && !thin && w >= 1.0f && !textured) {
       const ModelSpec& rough = *findModel("rough_dielectric");
       const float eta = std::clamp(m.ior, 1.01f, 4.0f);
@@ -1351,7 +1355,7 @@ class Converter {
                  " (rough_dielectric's eta is in [1.01, 4])");
       m.model = rough.id;
       m.params = packParams(rough, {{"alpha", ParamValue::num(std::clamp(r * r, 0.001f, 1.0f))},
-                                    {"eta", ParamValue::num(eta)}},
+                                    {"eta", ParamValue::num(eta)}, {"tint", tint}},
                             context + " (rough transmission)");
       return;
     }
@@ -1361,7 +1365,7 @@ class Converter {
                      : "transmissionFactor x (1 - metallic) < 1 or a transmissionTexture applies") +
                " (rough transmission renders only as rough_dielectric alone; docs/scenes.md, \"Transmission\")");
     const ModelSpec& glassModel = *findModel(thin ? "thin_dielectric" : "dielectric");
-    BrdfParams glass = packParams(glassModel, {{"eta", ParamValue::num(std::min(m.ior, 10.0f))}},
+    BrdfParams glass = packParams(glassModel, {{"eta", ParamValue::num(std::min(m.ior, 10.0f))}, {"tint", tint}},
                                   context + " (transmission)");
     if (w >= 1.0f && !textured) {
       m.model = glassModel.id;
@@ -1385,10 +1389,10 @@ class Converter {
   // transmission texture of the transmission combination).
   void warnUnrenderedTextures(const Material& m) {
     if (m.transmissionTexture.present() && !m.transmissionTextured) notRenderedYet("transmissionTexture");
-    if ((m.combined() || m.model != MODEL_GLTF_PBR) &&
-        (m.baseColorTexture.present() || m.metallicRoughnessTexture.present()))
-      notRenderedYet("baseColorTexture/metallicRoughnessTexture RGB of materials other than a single gltf_pbr "
-                     "(NUSSELT_brdf models, combined or transmissive materials)");
+    if ((m.baseColorTexture.present() && !m.hasGltfPbr() && !m.hasTintedTransmission()) ||
+        (m.metallicRoughnessTexture.present() && !m.hasGltfPbr()))
+      notRenderedYet("baseColorTexture/metallicRoughnessTexture RGB of materials without a gltf_pbr (or, for the "
+                     "base colour, transmitting) model or component (NUSSELT_brdf models)");
   }
 
   std::uint32_t defaultMaterial() {

@@ -65,6 +65,26 @@ MaterialComponent catalogueComponent(const std::string& model, const NamedParams
   return c;
 }
 
+namespace {
+template <class F>
+bool anyModel(const Material& m, F f) {
+  if (!m.combined()) return f(m.model);
+  for (const MaterialComponent& c : m.components)
+    if (f(c.model)) return true;
+  return false;
+}
+}  // namespace
+
+bool Material::hasGltfPbr() const {
+  return anyModel(*this, [](std::uint32_t id) { return id == MODEL_GLTF_PBR; });
+}
+
+bool Material::hasTintedTransmission() const {
+  return anyModel(*this, [](std::uint32_t id) {
+    return id == MODEL_DIELECTRIC || id == MODEL_THIN_DIELECTRIC || id == MODEL_ROUGH_DIELECTRIC;
+  });
+}
+
 void setComponents(Material& m, const std::vector<MaterialComponent>& components) {
   if (components.empty()) throw Error(m.name + ": a combined material needs at least one component");
   m.components = components;

@@ -112,6 +112,12 @@ struct Material {
   bool absorbs() const { return absorption.x > 0.0f || absorption.y > 0.0f || absorption.z > 0.0f; }
   // True when a normal map needs tangents at this material's triangles.
   bool normalMapped() const { return normalTexture.present(); }
+  // The models a base-colour or metallic-roughness texture's RGB applies to (docs/scenes.md,
+  // "Textures"), as the material's model or one of its components: gltf_pbr (base colour,
+  // metallic, roughness) and, for the base colour, the transmitting models dielectric,
+  // thin_dielectric and rough_dielectric (their tint: glTF's tinted transmission).
+  bool hasGltfPbr() const;
+  bool hasTintedTransmission() const;
 };
 
 enum class LightType { Point, Spot, Directional };

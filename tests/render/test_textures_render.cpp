@@ -309,53 +309,36 @@ TEST(TexturesRender, EmittersWithAlphaAgreeUnderNeeBsdfAndMis) {
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
-// gltf_pbr with a 2 x 2 baseColor texture (sRGB) and a 2 x 2 metallicRoughness texture (linear:
-// G roughness, B metallic), both NEAREST, times the factors, on a quad under a uniform white sky
-// (radiance 1), seen straight down, max depth 1: each 8 x 8 pixel cell converges to the
-// directional albedo at normal incidence of its texels' parameters, integral of f cos over the
-// hemisphere, computed here from the same BRDF (shared C++ build) by a stratified 1024 x 1024
-// cosine-weighted quadrature. z-test per cell and channel with the cell's variance of the mean
-// (from the per-pixel variances), significance 0.001 with Sidak over 12 tests. The predicted
-// albedos of the cells differ by more than 20 standard errors, so an ignored texture fails.
-TEST(TexturesRender, BaseColorAndMetallicRoughnessTexturesGiveThePredictedAlbedo) {
-  Scene s;
-  const glm::vec3 baseFactor(0.9f, 0.8f, 1.0f);
-  const float metallicFactor = 0.8f, roughnessFactor = 0.9f;
-  Material m = gltfPbr(baseFactor, metallicFactor, roughnessFactor);
-  int bc = addImage(s, 2, 2, [](int x, int y) {
-    const int* c = kCodes[x + 2 * y];
-    return glm::ivec4(c[0], c[1], c[2], 255);
-  });
-  // (G roughness, B metallic) per texel: rough dielectric, smoother half-metal, metal, mid.
-  const int mr[4][2] = {{255, 0}, {100, 128}, {160, 255}, {200, 64}};
-  int mrImage = addImage(s, 2, 2, [&](int x, int y) { return glm::ivec4(0, mr[x + 2 * y][0], mr[x + 2 * y][1], 255); });
-  m.baseColorTexture = nearest(bc, ColorSpace::Srgb);
-  m.metallicRoughnessTexture = nearest(mrImage, ColorSpace::Linear);
+// The directional albedo at normal incidence of gltf_pbr(base, metal, rough), the integral of
+// f cos over the hemisphere, by a stratified 1024 x 1024 cosine-weighted quadrature of the same
+// BRDF (shared C++ build).
+glm::dvec3 gltfPbrAlbedoAtNormalIncidence(glm::vec3 base, float metal, float rough) {
+  Material p = gltfPbr(base, metal, rough);
+  const int n = 1024;
+  glm::dvec3 a(0.0);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      glm::vec3 wi = shared::squareToCosineHemisphere(glm::vec2((i + 0.5f) / n, (j + 0.5f) / n));
+      glm::vec3 f = shared::brdfEval(MODEL_GLTF_PBR, p.params, wi, glm::vec3(0, 0, 1));
+      for (int k = 0; k < 3; ++k) a[k] += f[k] * M_PI;  // f cos / pdf, pdf = cos / pi
+    }
+  return a / (double(n) * n);
+}
+
+// A quad of material `m` (its textures' images already in s) under a uniform white sky (radiance
+// 1), seen straight down, max depth 1, 256 spp: each 8 x 8 pixel cell (texel x + 2 y of 2 x 2
+// NEAREST textures) must converge to predicted[cell]. z-test per cell and channel with the cell's
+// variance of the mean (from the per-pixel variances), significance 0.001 with Sidak over 12
+// tests; every pair of cells' predictions must differ by more than 20 standard errors in some
+// channel, so that an ignored texture fails.
+void expectCellsConverge(Scene s, const Material& m, const glm::dvec3 (&predicted)[4], std::uint32_t seed) {
   s.materials.push_back(m);
   addTexturedQuad(s, 0.0f, 0);
   lookDown(s, 1.0f, 1.0f);
   s.background = glm::vec3(1.0f);
-  RenderSettings rs = exactSettings(1, 7, 256);
+  RenderSettings rs = exactSettings(1, seed, 256);
   test::Rendered r = test::render(s, rs);
-
   const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 12.0)));
-  double predicted[4][3];
-  for (int cell = 0; cell < 4; ++cell) {
-    glm::vec3 base(float(baseFactor.x * srgb(kCodes[cell][0])), float(baseFactor.y * srgb(kCodes[cell][1])),
-                   float(baseFactor.z * srgb(kCodes[cell][2])));
-    float rough = roughnessFactor * float(mr[cell][0]) / 255.0f;
-    float metal = metallicFactor * float(mr[cell][1]) / 255.0f;
-    Material p = gltfPbr(base, metal, rough);
-    const int n = 1024;
-    double a[3] = {0, 0, 0};
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        glm::vec3 wi = shared::squareToCosineHemisphere(glm::vec2((i + 0.5f) / n, (j + 0.5f) / n));
-        glm::vec3 f = shared::brdfEval(MODEL_GLTF_PBR, p.params, wi, glm::vec3(0, 0, 1));
-        for (int k = 0; k < 3; ++k) a[k] += f[k] * M_PI;  // f cos / pdf, pdf = cos / pi
-      }
-    for (int k = 0; k < 3; ++k) predicted[cell][k] = a[k] / (double(n) * n);
-  }
   double seOf[4][3];
   for (int cell = 0; cell < 4; ++cell) {
     int cx = cell % 2, cy = cell / 2;
@@ -373,7 +356,6 @@ TEST(TexturesRender, BaseColorAndMetallicRoughnessTexturesGiveThePredictedAlbedo
                                     << predicted[cell][k] << " (se " << se << ")";
     }
   }
-  // Every pair of cells is told apart in some channel.
   double minSeparation = 1e30;
   for (int c1 = 0; c1 < 4; ++c1)
     for (int c2 = c1 + 1; c2 < 4; ++c2) {
@@ -385,6 +367,69 @@ TEST(TexturesRender, BaseColorAndMetallicRoughnessTexturesGiveThePredictedAlbedo
     }
   EXPECT_GT(minSeparation, 20.0) << "the cells' predicted albedos are too close to tell textures apart";
   EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// The 2 x 2 textures of the tests below: a baseColor texture (sRGB, kCodes) and a
+// metallicRoughness texture (linear: G roughness, B metallic; per texel a rough dielectric, a
+// smoother half-metal, a metal and a mid), both NEAREST, on m; predicted[cell] = the albedo of
+// gltf_pbr with that texel's parameters (times the factors).
+const int kMetallicRoughness[4][2] = {{255, 0}, {100, 128}, {160, 255}, {200, 64}};
+
+void addPbrTextures(Scene& s, Material& m) {
+  int bc = addImage(s, 2, 2, [](int x, int y) {
+    const int* c = kCodes[x + 2 * y];
+    return glm::ivec4(c[0], c[1], c[2], 255);
+  });
+  int mrImage = addImage(s, 2, 2, [&](int x, int y) {
+    return glm::ivec4(0, kMetallicRoughness[x + 2 * y][0], kMetallicRoughness[x + 2 * y][1], 255);
+  });
+  m.baseColorTexture = nearest(bc, ColorSpace::Srgb);
+  m.metallicRoughnessTexture = nearest(mrImage, ColorSpace::Linear);
+}
+
+glm::dvec3 texelPbrAlbedo(int cell, glm::vec3 baseFactor, float metallicFactor, float roughnessFactor) {
+  glm::vec3 base(float(baseFactor.x * srgb(kCodes[cell][0])), float(baseFactor.y * srgb(kCodes[cell][1])),
+                 float(baseFactor.z * srgb(kCodes[cell][2])));
+  float rough = roughnessFactor * float(kMetallicRoughness[cell][0]) / 255.0f;
+  float metal = metallicFactor * float(kMetallicRoughness[cell][1]) / 255.0f;
+  return gltfPbrAlbedoAtNormalIncidence(base, metal, rough);
+}
+
+// gltf_pbr with a 2 x 2 baseColor texture and a 2 x 2 metallicRoughness texture times the
+// factors: each cell converges to the albedo of its texels' parameters (expectCellsConverge).
+TEST(TexturesRender, BaseColorAndMetallicRoughnessTexturesGiveThePredictedAlbedo) {
+  Scene s;
+  const glm::vec3 baseFactor(0.9f, 0.8f, 1.0f);
+  const float metallicFactor = 0.8f, roughnessFactor = 0.9f;
+  Material m = gltfPbr(baseFactor, metallicFactor, roughnessFactor);
+  addPbrTextures(s, m);
+  glm::dvec3 predicted[4];
+  for (int cell = 0; cell < 4; ++cell) predicted[cell] = texelPbrAlbedo(cell, baseFactor, metallicFactor, roughnessFactor);
+  expectCellsConverge(s, m, predicted, 7);
+}
+
+// The same textures on the gltf_pbr component (weight 0.6) of a combined material with a Lambert
+// component (rho 0.5, weight 0.4; NUSSELT_brdf components, or glTF's transmission combination):
+// the textures apply to the gltf_pbr component alone (texturedParams in the shade stage), which is
+// cosine-sampled (no one table fits its texels) while the Lambert component keeps its quadtree;
+// each cell converges to 0.6 x its texels' gltf_pbr albedo + 0.4 x 0.5.
+TEST(TexturesRender, TexturesApplyToTheGltfPbrComponentOfACombinedMaterial) {
+  Scene s;
+  const glm::vec3 baseFactor(0.9f, 0.8f, 1.0f);
+  const float metallicFactor = 0.8f, roughnessFactor = 0.9f;
+  Material m = gltfPbr(baseFactor, metallicFactor, roughnessFactor);
+  setComponents(m, {catalogueComponent("gltf_pbr",
+                                       {{"baseColor", arrayValue({ParamValue::num(baseFactor.x), ParamValue::num(baseFactor.y),
+                                                                  ParamValue::num(baseFactor.z)})},
+                                        {"metallic", ParamValue::num(metallicFactor)},
+                                        {"roughness", ParamValue::num(roughnessFactor)}},
+                                       0.6f),
+                    catalogueComponent("lambert", {{"rho", ParamValue::num(0.5)}}, 0.4f)});
+  addPbrTextures(s, m);
+  glm::dvec3 predicted[4];
+  for (int cell = 0; cell < 4; ++cell)
+    predicted[cell] = 0.6 * texelPbrAlbedo(cell, baseFactor, metallicFactor, roughnessFactor) + glm::dvec3(0.4 * 0.5);
+  expectCellsConverge(s, m, predicted, 9);
 }
 
 // Normal maps: two flat quads (Lambert, rho 0.5) side by side, each with a constant 1 x 1 normal
@@ -710,6 +755,71 @@ TEST(TexturesRender, TransmissionTextureScalesTheTransmittedLight) {
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
+// KHR_materials_transmission's tinting through the loader: scenes/tests/glass_slab_base_color.gltf,
+// the slab of GlassSlabTransmitsAsFresnelPredicts with baseColorFactor c = (0.8, 0.5, 0.2), which
+// colours the light the boundary transmits at each crossing (the dielectric's tint; internal
+// reflections are not tinted): the image converges to c^2 (1 - R)^2 / (1 - R^2) = c^2 (1 - R) / (1 + R)
+// per channel, R = 0.04. Tinting once per path through the slab would give c (1 - R) / (1 + R),
+// 2-5x brighter. z-test of the image mean per channel, significance 0.001 with Sidak over 3.
+TEST(TexturesRender, BaseColorTintsTheTransmissionAtEachCrossing) {
+  Scene s = test::loadTestScene("scenes/tests/glass_slab_base_color.gltf");
+  lookDown(s, 1.0f, 0.9f);
+  RenderSettings rs = exactSettings(32, 37, 64);
+  const double R = 0.04;
+  const glm::dvec3 c(0.8, 0.5, 0.2);
+  expectImageMeanRgb(test::render(s, rs), c * c * ((1 - R) / (1 + R)));
+}
+
+// The base-colour texture tints the transmitted light too: a thin-walled sheet at z = 0.3 with a
+// 2 x 1 NEAREST sRGB base-colour texture (codes (255, 128, 64) over x < 0, (64, 200, 255) over
+// x > 0) over an emitter of radiance 1, seen straight down: each half converges to
+// srgb(code) x (1 - R1) / (1 + R1), R1 = 0.04, per channel. Twice: as thin_dielectric alone (the
+// loader's w = 1) and as the glTF combination {gltf_pbr, 0; thin_dielectric, 1} (w < 1 or a
+// transmission texture), whose components the shade stage textures. z-test of each half's mean
+// per channel, significance 0.001 with Sidak over 6; each half must also differ from the untinted
+// value in some channel by 10 standard errors.
+TEST(TexturesRender, BaseColorTextureTintsTheTransmittedLight) {
+  const int codes[2][3] = {{255, 128, 64}, {64, 200, 255}};
+  for (bool combined : {false, true}) {
+    SCOPED_TRACE(combined ? "combination" : "thin_dielectric alone");
+    Scene s;
+    const int image = addImage(s, 2, 1, [&](int x, int) { return glm::ivec4(codes[x][0], codes[x][1], codes[x][2], 255); });
+    Material m = catalogueMaterial("thin_dielectric", {{"eta", ParamValue::num(1.5)}}, "stained");
+    if (combined)
+      setComponents(m, {catalogueComponent("gltf_pbr", {{"metallic", ParamValue::num(0.0)}}, 0.0f),
+                        catalogueComponent("thin_dielectric", {{"eta", ParamValue::num(1.5)}}, 1.0f)});
+    m.baseColorTexture = nearest(image, ColorSpace::Srgb);
+    s.materials.push_back(m);
+    s.materials.push_back(catalogueMaterial("lambert", {{"rho", ParamValue::num(0.0)}}, "lamp", glm::vec3(1.0f)));
+    addTexturedQuad(s, 0.3f, 0);
+    addTexturedQuad(s, 0.0f, 1, 2.0f);
+    lookDown(s, 1.0f, 0.9f);
+    RenderSettings rs = exactSettings(4, combined ? 43 : 41, 64);
+    rs.sampler = SamplerKind::Cosine;  // nothing above the sheet to reflect: no tables needed
+    const test::Rendered r = test::render(s, rs);
+    const double T = 0.96 / 1.04;
+    const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 6.0)));
+    for (int half = 0; half < 2; ++half) {
+      double farthest = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double expected = srgb(codes[half][k]) * T;
+        double sum = 0, var = 0;
+        for (int py = 0; py < 16; ++py)
+          for (int px = 8 * half; px < 8 * half + 8; ++px) {
+            sum += r.image.rgb[3 * (py * 16 + px) + k];
+            var += r.image.variance[3 * (py * 16 + px) + k];
+          }
+        const double mean = sum / 128, se = std::sqrt(var) / 128;
+        EXPECT_LT(std::fabs(mean - expected) / se, zMax)
+            << "half " << half << " channel " << k << ": " << mean << " vs " << expected << " (se " << se << ")";
+        farthest = std::max(farthest, std::fabs(mean - T) / se);
+      }
+      EXPECT_GT(farthest, 10.0) << "half " << half << " is not tinted";
+    }
+  }
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
 // ---- Rough transmission: rough_dielectric in the path tracer (issue 18) ----
 namespace {
 
@@ -831,6 +941,23 @@ TEST(RoughTransmission, SmoothLimitTransmitsAsTheSmoothDielectric) {
                 rough ? "rough_dielectric alpha 0.001" : "dielectric", mean, se, expected, (mean - expected) / se);
     EXPECT_LT(std::fabs(mean - expected), zMax * std::max(se, 1e-7)) << (rough ? "rough" : "smooth");
   }
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// The tint (glTF's base colour on rough transmission): the smooth limit above with tint
+// c = (0.8, 0.5, 0.2) transmits c (1 - R) / eta^2 per channel (the tinted transmission lobe is
+// in f, so the quadtree's tables and MIS see it). z-test of the image mean per channel,
+// significance 0.001 with Sidak over 3 (expectImageMeanRgb).
+TEST(RoughTransmission, TintColoursTheTransmittedLight) {
+  const double eta = 1.5;
+  const glm::dvec3 c(0.8, 0.5, 0.2);
+  Material glass = catalogueMaterial(
+      "rough_dielectric",
+      {{"alpha", ParamValue::num(double(0.001f))}, {"eta", ParamValue::num(eta)},
+       {"tint", arrayValue({ParamValue::num(c.x), ParamValue::num(c.y), ParamValue::num(c.z)})}},
+      "tinted frosted glass");
+  const test::Rendered r = test::render(emitterUnderRoughInterface(glass), exactSettings(1, 45, 64));
+  expectImageMeanRgb(r, c * ((1 - fresnelUnpolarised(kRoughTheta, eta)) / (eta * eta)));
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 

@@ -539,14 +539,18 @@ TEST(GltfTextures, TransmissionBecomesTheDielectric) {
   EXPECT_EQ(m.components[1].model, MODEL_DIELECTRIC);
   EXPECT_FLOAT_EQ(m.components[1].weight, 0.6f);
   EXPECT_FLOAT_EQ(m.components[1].params.v[DIELECTRIC_ETA / 4][DIELECTRIC_ETA % 4], 1.33f);
+  // The base colour (default white) tints the transmission.
+  EXPECT_EQ(shared::brdfParam3(m.components[1].params, DIELECTRIC_TINT), glm::vec3(1.0f));
   EXPECT_FALSE(hasWarning(s, "read but not rendered yet"));
-  j["materials"][0] = Json::parse(R"({"name": "glass", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
+  j["materials"][0] = Json::parse(R"({"name": "glass", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0,
+    "baseColorFactor": [0.8, 0.5, 0.2, 1]},
     "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
                    "KHR_materials_volume": {"thicknessFactor": 0.1}}})");
   const Material g = loadJson(j).materials[0];
   EXPECT_FALSE(g.combined());
   EXPECT_EQ(g.model, MODEL_DIELECTRIC);
   EXPECT_FLOAT_EQ(g.params.v[DIELECTRIC_ETA / 4][DIELECTRIC_ETA % 4], 1.5f);
+  EXPECT_EQ(shared::brdfParam3(g.params, DIELECTRIC_TINT), glm::vec3(0.8f, 0.5f, 0.2f));
   // Thin-walled: no volume, or a volume of thickness 0.
   for (const char* volume : {"", R"(, "KHR_materials_volume": {"thicknessFactor": 0})"}) {
     j["materials"][0] = Json::parse(std::string(R"({"name": "pane", "pbrMetallicRoughness": {"metallicFactor": 0},

@@ -1,5 +1,8 @@
 // dielectric: ideal smooth interface with Fresnel reflection/refraction and total internal
-// reflection (docs/brdf-models.md 2.19). eta = n_inside / n_outside (inside = -z side).
+// reflection (docs/brdf-models.md 2.19). eta = n_inside / n_outside (inside = -z side). tint: the
+// colour of the light the interface transmits (1 = clear), at every crossing, as glTF's baseColor
+// tints KHR_materials_transmission ("a coloured foil" on the volume's boundary); reflection is
+// untinted.
 // Delta model: dielectricEval is 0. Analytic sampling: dielectricReflectance gives the
 // probability of reflection; dielectricRefract the transmitted direction.
 #ifndef NUSSELT_BRDF_DIELECTRIC_H
@@ -8,6 +11,7 @@
 SHARED_BEGIN
 
 #define DIELECTRIC_ETA 0u
+#define DIELECTRIC_TINT 1u
 
 SHARED_FN vec3 dielectricEval(BrdfParams p, vec3 wi, vec3 wo) {
   BRDF_UNUSED(p);
@@ -43,7 +47,7 @@ SHARED_FN bool dielectricRefract(float eta, vec3 w, OUT(vec3) t) {
 }
 
 // ---- Delta sampling (dispatch.h) ----
-// Reflect with probability R (Fresnel), refract otherwise: weight 1 for either, times the
+// Reflect with probability R (Fresnel), refract otherwise: weight 1 for a reflection, tint times the
 // radiance scaling (n_wo / n_wi)^2 across the interface for refraction (catalogue 2.19). inside:
 // the path arrived from the inside, where the relative index is 1/eta.
 SHARED_FN bool dielectricDeltaSample(BrdfParams p, vec3 wo, bool inside, vec2 u, OUT(vec3) wi, OUT(vec3) weight,
@@ -57,19 +61,19 @@ SHARED_FN bool dielectricDeltaSample(BrdfParams p, vec3 wo, bool inside, vec2 u,
     weight = vec3(1.0f);
   } else {
     wi = t;
-    weight = vec3(1.0f / (etaRel * etaRel));
+    weight = brdfParam3(p, DIELECTRIC_TINT) * (1.0f / (etaRel * etaRel));
   }
   // The walk does not end at a lossless interface: the radiance scaling is not an albedo.
   continuation = 1.0f;
   return true;
 }
 
-// Lossless: reflection and transmission together carry everything.
+// R + (1 - R) t, t the tint's luminance or largest channel: 1 for a clear (lossless) interface,
+// written as 1 - (1 - t)(1 - R) so that t = 1 gives exactly 1.
 SHARED_FN float dielectricDeltaChoiceAlbedo(BrdfParams p, vec3 wo, bool largestChannel) {
-  BRDF_UNUSED(p);
-  BRDF_UNUSED(wo);
-  BRDF_UNUSED(largestChannel);
-  return 1.0f;
+  vec3 tint = brdfParam3(p, DIELECTRIC_TINT);
+  float t = largestChannel ? maxComponent(tint) : luminance(tint);
+  return 1.0f - (1.0f - t) * (1.0f - fresnelDielectric(wo.z, brdfParam(p, DIELECTRIC_ETA)));
 }
 
 // (n_wi / n_wo)^2 of a refracted sample.
@@ -95,6 +99,7 @@ inline void dielectricSpec(ModelSpec& m) {
   m.name = "dielectric";
   m.summary = "ideal refraction with Fresnel and total internal reflection (delta)";
   m.params.push_back(scalar("eta", DIELECTRIC_ETA, 1.5f, 0.1f, 10.0f, false, "n_inside / n_outside"));
+  m.params.push_back(colour("tint", DIELECTRIC_TINT, 1.0f, 0.0f, 1.0f, "colour of the transmitted light, per crossing"));
   m.typical = {N("eta", 1.5)};
   m.hard = {N("eta", 2.42)};
 }

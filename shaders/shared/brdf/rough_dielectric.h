@@ -28,7 +28,9 @@
 //
 // Symmetry of the sides: f(wi, wo; eta) = f(flipZ(wi), flipZ(wo); 1 / eta) exactly (only the index
 // ratios enter), so a path inside the material is the outside case with 1 / eta (tested).
-// Params: alpha (GGX roughness, not perceptual: alpha = roughness^2 in glTF terms), eta.
+// Params: alpha (GGX roughness, not perceptual: alpha = roughness^2 in glTF terms), eta, tint (the
+// colour of the transmitted light at every crossing, 1 = clear: glTF's baseColor on
+// KHR_materials_transmission; the transmission term above times tint, reflection untinted).
 #ifndef NUSSELT_BRDF_ROUGH_DIELECTRIC_H
 #define NUSSELT_BRDF_ROUGH_DIELECTRIC_H
 #include "common.h"
@@ -37,6 +39,7 @@ SHARED_BEGIN
 
 #define ROUGH_DIELECTRIC_ALPHA 0u
 #define ROUGH_DIELECTRIC_ETA 1u
+#define ROUGH_DIELECTRIC_TINT 2u
 
 // Smith G1 of GGX for direction w (either side) and microfacet normal m (m.z > 0): zero when w
 // sees the back of m ((w.m)(w.z) <= 0). 2 / (1 + sqrt(1 + alpha^2 tan^2)) written with cos and
@@ -84,7 +87,8 @@ SHARED_FN float roughDielectricF(float alpha, float eta, vec3 wi, vec3 wo) {
 SHARED_FN vec3 roughDielectricEval(BrdfParams p, vec3 wi, vec3 wo) {
   float alpha = brdfParam(p, ROUGH_DIELECTRIC_ALPHA);
   float eta = brdfParam(p, ROUGH_DIELECTRIC_ETA);
-  return vec3(roughDielectricF(alpha, eta, wi, wo));
+  vec3 f = vec3(roughDielectricF(alpha, eta, wi, wo));
+  return wi.z * wo.z < 0.0f ? f * brdfParam3(p, ROUGH_DIELECTRIC_TINT) : f;
 }
 
 // The parameters seen from the inside, in the frame turned over so that the inside is +z (the
@@ -129,6 +133,7 @@ inline void roughDielectricSpec(ModelSpec& m) {
                             "GGX roughness (alpha, not perceptual roughness)"));
   m.params.push_back(scalar("eta", ROUGH_DIELECTRIC_ETA, 1.5f, 1.01f, 4.0f, false,
                             "n_inside / n_outside (inside = -z side)"));
+  m.params.push_back(colour("tint", ROUGH_DIELECTRIC_TINT, 1.0f, 0.0f, 1.0f, "colour of the transmitted light, per crossing"));
   m.typical = {N("alpha", 0.2), N("eta", 1.5)};
   m.hard = {N("alpha", 0.02), N("eta", 2.42)};
   // The tree builder's lower disc: the refraction direction of v (v above the surface, the

@@ -4,7 +4,8 @@
 // vanishing thickness does not bend rays. eta = n_sheet / n_outside. With R1 the Fresnel
 // reflectance at the angle of incidence (the inner interface has the same, by reciprocity), the
 // sheet reflects R = R1 + (1 - R1)^2 R1 (1 + R1^2 + R1^4 + ...) = 2 R1 / (1 + R1) and transmits
-// T = 1 - R = (1 - R1) / (1 + R1), along -wo; nothing is absorbed.
+// T = 1 - R = (1 - R1) / (1 + R1), along -wo, times tint (1 = clear; glTF's baseColor tints thin-walled
+// transmission); nothing else is absorbed.
 // Delta model: thinDielectricEval is 0.
 #ifndef NUSSELT_BRDF_THIN_DIELECTRIC_H
 #define NUSSELT_BRDF_THIN_DIELECTRIC_H
@@ -12,6 +13,7 @@
 SHARED_BEGIN
 
 #define THIN_DIELECTRIC_ETA 0u
+#define THIN_DIELECTRIC_TINT 1u
 
 SHARED_FN vec3 thinDielectricEval(BrdfParams p, vec3 wi, vec3 wo) {
   BRDF_UNUSED(p);
@@ -27,24 +29,24 @@ SHARED_FN float thinDielectricReflectance(float eta, vec3 w) {
 }
 
 // ---- Delta sampling (dispatch.h) ----
-// Reflect with probability R, else pass straight through: weight 1 either way (no radiance
-// scaling: the same medium on both sides). The sheet is symmetric, so `inside` does not matter.
+// Reflect with probability R, else pass straight through: weight 1, or tint for the passage (no
+// radiance scaling: the same medium on both sides). The sheet is symmetric, so `inside` does not matter.
 SHARED_FN bool thinDielectricDeltaSample(BrdfParams p, vec3 wo, bool inside, vec2 u, OUT(vec3) wi, OUT(vec3) weight,
                                          OUT(float) continuation) {
   BRDF_UNUSED(inside);
   float R = thinDielectricReflectance(brdfParam(p, THIN_DIELECTRIC_ETA), wo);
-  wi = u.x < R ? brdfReflectZ(wo) : -wo;
-  weight = vec3(1.0f);
+  bool reflect = u.x < R;
+  wi = reflect ? brdfReflectZ(wo) : -wo;
+  weight = reflect ? vec3(1.0f) : brdfParam3(p, THIN_DIELECTRIC_TINT);
   continuation = 1.0f;  // lossless: the walk does not end here
   return true;
 }
 
-// Lossless: reflection and transmission together carry everything.
+// R + (1 - R) t as the dielectric's (1 for a clear sheet, exactly).
 SHARED_FN float thinDielectricDeltaChoiceAlbedo(BrdfParams p, vec3 wo, bool largestChannel) {
-  BRDF_UNUSED(p);
-  BRDF_UNUSED(wo);
-  BRDF_UNUSED(largestChannel);
-  return 1.0f;
+  vec3 tint = brdfParam3(p, THIN_DIELECTRIC_TINT);
+  float t = largestChannel ? maxComponent(tint) : luminance(tint);
+  return 1.0f - (1.0f - t) * (1.0f - thinDielectricReflectance(brdfParam(p, THIN_DIELECTRIC_ETA), wo));
 }
 
 // The same medium on both sides: a transmitted sample's radiance is not rescaled.
@@ -70,6 +72,7 @@ inline void thinDielectricSpec(ModelSpec& m) {
   m.name = "thin_dielectric";
   m.summary = "thin dielectric sheet: Fresnel reflection between its faces, straight transmission (delta)";
   m.params.push_back(scalar("eta", THIN_DIELECTRIC_ETA, 1.5f, 0.1f, 10.0f, false, "n_sheet / n_outside"));
+  m.params.push_back(colour("tint", THIN_DIELECTRIC_TINT, 1.0f, 0.0f, 1.0f, "colour of the transmitted light"));
   m.typical = {N("eta", 1.5)};
   m.hard = {N("eta", 2.42)};
 }
