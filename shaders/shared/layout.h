@@ -174,7 +174,8 @@ struct GpuMaterial {
 STATIC_ASSERT_SIZE(GpuMaterial, 192);
 
 // One term w * f_k of a combined material (shaders/shared/combined.h).
-// info = (model id, quadtree set index or INVALID_INDEX, 0, 0); data = (weight w, 0, 0, 0);
+// info = (model id, quadtree set index or INVALID_INDEX, 1 for a gltf_pbr component sampled by the
+// roughness bins (binned sampling: its textures vary it) else 0, 0); data = (weight w, 0, 0, 0);
 // albedoLo, albedoHi = the component's directional albedo (without w) at cos theta_o = i / 7, i = 0..3
 // in albedoLo and 4..7 in albedoHi, computed on the CPU: its largest RGB channel under the throughput
 // roulette (every non-delta component), its luminance under the albedo roulette (components without

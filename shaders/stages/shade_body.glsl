@@ -22,6 +22,16 @@ const uint MODEL_ID = NUSSELT_SHADE_MODEL_ID;
 layout(constant_id = 0) const uint MODEL_ID = 0u;
 #endif
 layout(constant_id = 1) const uint SAMPLER = SAMPLER_QUADTREE;
+// Binned sampling (bsdf_sampling.h, "Binned sampling"): a gltf_pbr material or component whose
+// textures vary its parameters (MATERIAL_BINNED, GpuComponent.info.z) under the quadtree strategy,
+// in a scene that has such materials (constant 12, HAS_BINS: set by the integrator when
+// Globals.roughnessBins.count > 0; without it, and in modules without the scene features or the
+// quadtree, the code is not there).
+#define NUSSELT_BINNED (NUSSELT_SCENE_FEATURES && NUSSELT_WITH_QUADTREE)
+#if NUSSELT_BINNED
+layout(constant_id = 12) const bool HAS_BINS = false;
+#endif
+
 #if SHADE_COMBINED
 // 1..MAX_COMPONENTS: the number of components of the combined material.
 layout(constant_id = 2) const uint COMPONENT_COUNT = 1u;
@@ -35,9 +45,36 @@ layout(constant_id = 6) const uint MODEL_3 = 0u;
 vec3 componentEval(uint model, GpuComponent C, vec3 wi, vec3 wo) {
   return modelIsDelta(model) ? vec3(0.0f) : C.data.x * brdfEval(model, C.params, wi, wo);
 }
+// A gltf_pbr component whose textures vary its parameters samples the roughness bins
+// (GpuComponent.info.z = 1, set by the renderer only where HAS_BINS is).
+bool componentBinned(uint model, GpuComponent C) {
+#if NUSSELT_BINNED
+  return HAS_BINS && model == MODEL_GLTF_PBR && C.info.z != 0u;
+#else
+  return false;
+#endif
+}
+
+// pdf_k(wi): the component's sampler's density (bsdfPdf, or the binned mixture's).
+float componentPdf(uint model, GpuComponent C, vec3 wo, vec3 wi) {
+#if NUSSELT_BINNED
+  if (componentBinned(model, C)) return binnedPdf(g.roughnessBins, C.params, wo, wi);
+#endif
+  return bsdfPdf(SAMPLER, model, C.info.y, C.params, wo, wi);
+}
+
+// The component's sample (bsdfSample, or the binned mixture's).
+bool componentSample(uint model, GpuComponent C, vec3 wo, bool inside, vec2 u, out vec3 wi, out vec3 weight,
+                     out float pdf, out float q) {
+#if NUSSELT_BINNED
+  if (componentBinned(model, C)) return binnedBsdfSample(g.roughnessBins, C.params, wo, u, wi, weight, pdf, q);
+#endif
+  return bsdfSample(SAMPLER, model, C.info.y, C.params, wo, inside, u, wi, weight, pdf, q);
+}
+
 // c_k pdf_k(wi): the component's share of the MIS density (0 for delta components).
 float componentMisPdf(uint model, GpuComponent C, float c, vec3 wo, vec3 wi) {
-  return c > 0.0f ? c * bsdfPdf(SAMPLER, model, C.info.y, C.params, wo, wi) : 0.0f;
+  return c > 0.0f ? c * componentPdf(model, C, wo, wi) : 0.0f;
 }
 #endif
 
@@ -190,14 +227,6 @@ struct PathStep {
 // nextEvent and continuePath below are written once over them.
 #if !SHADE_COMBINED
 // ---- A single-model material (MODEL_ID); guided where the guide has learned (guiding.h) ----
-// Binned sampling (bsdf_sampling.h, "Binned sampling"): a gltf_pbr material whose textures vary its
-// parameters (MATERIAL_BINNED) under the quadtree strategy, in a scene that has such materials
-// (constant 12, HAS_BINS: set by the integrator when Globals.roughnessBins.count > 0; without it,
-// and in modules without the scene features or the quadtree, the code is not there).
-#define NUSSELT_BINNED (NUSSELT_SCENE_FEATURES && NUSSELT_WITH_QUADTREE)
-#if NUSSELT_BINNED
-layout(constant_id = 12) const bool HAS_BINS = false;
-#endif
 struct ShadeMaterial {
   GpuMaterial M;
   GuideVertex gv;  // the guide's region (path guiding): never for delta or transmitting models
@@ -417,25 +446,25 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
   float wk = 0.0f;
   float etaK = 1.0f;  // transmissionEtaScale of the chosen component
   if (COMPONENT_COUNT > 0u && j == 0u) {
-    ok = bsdfSample(SAMPLER, MODEL_0, m.C0.info.y, m.C0.params, wo, inside, uB, wiLocal, weight, pdf, qk);
+    ok = componentSample(MODEL_0, m.C0, wo, inside, uB, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_0);
     wk = m.C0.data.x;
     etaK = transmissionEtaScale(MODEL_0, m.C0.params, inside);
   }
   if (COMPONENT_COUNT > 1u && j == 1u) {
-    ok = bsdfSample(SAMPLER, MODEL_1, m.C1.info.y, m.C1.params, wo, inside, uB, wiLocal, weight, pdf, qk);
+    ok = componentSample(MODEL_1, m.C1, wo, inside, uB, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_1);
     wk = m.C1.data.x;
     etaK = transmissionEtaScale(MODEL_1, m.C1.params, inside);
   }
   if (COMPONENT_COUNT > 2u && j == 2u) {
-    ok = bsdfSample(SAMPLER, MODEL_2, m.C2.info.y, m.C2.params, wo, inside, uB, wiLocal, weight, pdf, qk);
+    ok = componentSample(MODEL_2, m.C2, wo, inside, uB, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_2);
     wk = m.C2.data.x;
     etaK = transmissionEtaScale(MODEL_2, m.C2.params, inside);
   }
   if (COMPONENT_COUNT > 3u && j == 3u) {
-    ok = bsdfSample(SAMPLER, MODEL_3, m.C3.info.y, m.C3.params, wo, inside, uB, wiLocal, weight, pdf, qk);
+    ok = componentSample(MODEL_3, m.C3, wo, inside, uB, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_3);
     wk = m.C3.data.x;
     etaK = transmissionEtaScale(MODEL_3, m.C3.params, inside);

@@ -117,8 +117,17 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     return used[i] && settings.sampler == SamplerKind::Quadtree && settings.roughnessBins >= 2 && !m.combined() &&
            m.model == MODEL_GLTF_PBR && textureUse(m, scene).paramsVary();
   };
+  // ... and the gltf_pbr components of combined materials whose textures vary them (GpuComponent.info.z).
+  auto binnedComponent = [&](std::size_t i, std::size_t k) {
+    const Material& m = scene.materials[i];
+    return used[i] && settings.sampler == SamplerKind::Quadtree && settings.roughnessBins >= 2 && m.combined() &&
+           m.components[k].model == MODEL_GLTF_PBR && textureUse(m, scene).paramsVary();
+  };
   bool anyBinned = false;
-  for (std::size_t i = 0; i < scene.materials.size(); ++i) anyBinned = anyBinned || binnedMaterial(i);
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    anyBinned = anyBinned || binnedMaterial(i);
+    for (std::size_t k = 0; k < scene.materials[i].components.size(); ++k) anyBinned = anyBinned || binnedComponent(i, k);
+  }
   if (anyBinned) {
     if (!(settings.roughnessBinSpacing > 0.0f) || !std::isfinite(settings.roughnessBinSpacing))
       throw Error("the roughness bins' spacing must be a positive number");
@@ -145,7 +154,8 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
           uses.push_back({static_cast<std::uint32_t>(i), kInsideUse});
         }
       }
-      // A textured gltf_pbr component has no table either: cosine (MaterialTextureUse::paramsVary).
+      // A textured gltf_pbr component has no table either: the roughness bins above under the
+      // quadtree, else cosine (MaterialTextureUse::paramsVary).
       const bool pbrVaries = textureUse(m, scene).paramsVary();
       for (std::size_t k = 0; k < m.components.size(); ++k)
         if (!modelById(m.components[k].model).delta && !(pbrVaries && m.components[k].model == MODEL_GLTF_PBR)) {
@@ -240,7 +250,7 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     for (std::size_t k = 0; k < src.components.size(); ++k) {
       const MaterialComponent& c = src.components[k];
       GpuComponent gc{};
-      gc.info = glm::uvec4(c.model, setFor(material, static_cast<int>(k)), 0u, 0u);
+      gc.info = glm::uvec4(c.model, setFor(material, static_cast<int>(k)), binnedComponent(i, k) ? 1u : 0u, 0u);
       gc.data = glm::vec4(c.weight, 0.0f, 0.0f, 0.0f);
       gc.params = c.params;
       // Every non-delta component gets its albedo table under the throughput roulette; under the

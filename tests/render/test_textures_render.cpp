@@ -331,12 +331,15 @@ glm::dvec3 gltfPbrAlbedoAtNormalIncidence(glm::vec3 base, float metal, float rou
 // variance of the mean (from the per-pixel variances), significance 0.001 with Sidak over 12
 // tests; every pair of cells' predictions must differ by more than 20 standard errors in some
 // channel, so that an ignored texture fails.
-void expectCellsConverge(Scene s, const Material& m, const glm::dvec3 (&predicted)[4], std::uint32_t seed) {
+// adjust: changes to the settings (the sampler's). Returns the render.
+test::Rendered expectCellsConverge(Scene s, const Material& m, const glm::dvec3 (&predicted)[4], std::uint32_t seed,
+                                   const std::function<void(RenderSettings&)>& adjust = {}) {
   s.materials.push_back(m);
   addTexturedQuad(s, 0.0f, 0);
   lookDown(s, 1.0f, 1.0f);
   s.background = glm::vec3(1.0f);
   RenderSettings rs = exactSettings(1, seed, 256);
+  if (adjust) adjust(rs);
   test::Rendered r = test::render(s, rs);
   const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 12.0)));
   double seOf[4][3];
@@ -367,6 +370,7 @@ void expectCellsConverge(Scene s, const Material& m, const glm::dvec3 (&predicte
     }
   EXPECT_GT(minSeparation, 20.0) << "the cells' predicted albedos are too close to tell textures apart";
   EXPECT_EQ(test::validationMessages(), 0u);
+  return r;
 }
 
 // The 2 x 2 textures of the tests below: a baseColor texture (sRGB, kCodes) and a
@@ -410,9 +414,11 @@ TEST(TexturesRender, BaseColorAndMetallicRoughnessTexturesGiveThePredictedAlbedo
 
 // The same textures on the gltf_pbr component (weight 0.6) of a combined material with a Lambert
 // component (rho 0.5, weight 0.4; NUSSELT_brdf components, or glTF's transmission combination):
-// the textures apply to the gltf_pbr component alone (texturedParams in the shade stage), which is
-// cosine-sampled (no one table fits its texels) while the Lambert component keeps its quadtree;
-// each cell converges to 0.6 x its texels' gltf_pbr albedo + 0.4 x 0.5.
+// the textures apply to the gltf_pbr component alone (texturedParams in the shade stage), which
+// samples the roughness bins (no one table fits its texels; 6 bins, tables every 3 degrees to keep
+// the first build short) or, with --roughness-bins 0, the cosine, while the Lambert component
+// keeps its quadtree; each cell converges to 0.6 x its texels' gltf_pbr albedo + 0.4 x 0.5 under
+// both.
 TEST(TexturesRender, TexturesApplyToTheGltfPbrComponentOfACombinedMaterial) {
   Scene s;
   const glm::vec3 baseFactor(0.9f, 0.8f, 1.0f);
@@ -429,7 +435,14 @@ TEST(TexturesRender, TexturesApplyToTheGltfPbrComponentOfACombinedMaterial) {
   glm::dvec3 predicted[4];
   for (int cell = 0; cell < 4; ++cell)
     predicted[cell] = 0.6 * texelPbrAlbedo(cell, baseFactor, metallicFactor, roughnessFactor) + glm::dvec3(0.4 * 0.5);
-  expectCellsConverge(s, m, predicted, 9);
+  for (std::uint32_t bins : {6u, 0u}) {
+    SCOPED_TRACE(bins ? "binned" : "cosine");
+    test::Rendered r = expectCellsConverge(s, m, predicted, bins ? 9 : 11, [&](RenderSettings& rs) {
+      rs.roughnessBins = bins;
+      rs.samplerThetaTables = 30;
+    });
+    EXPECT_EQ(r.summary.roughnessBins, bins);
+  }
 }
 
 // Normal maps: two flat quads (Lambert, rho 0.5) side by side, each with a constant 1 x 1 normal
