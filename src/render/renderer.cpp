@@ -249,6 +249,13 @@ void Renderer::renderPass(std::uint32_t samples) {
     iterationEnd = std::min((2u << iteration) - 1, trainSpp);
     samples = std::min({samples, iterationEnd - m_guideSamples, m_settings.guideTrainPass});
   }
+  // The photon pre-pass (docs/guiding.md): before the first training iteration, its photons train
+  // the guide that iteration samples (again on a resume: retrainGuide starts from 0 samples).
+  if (training && m_guideSamples == 0 && !m_photonsTraced && m_settings.guidePhotons > 0) {
+    m_paths->photonPass(m_settings.guidePhotons);
+    m_guide->endPhotons();
+    m_photonsTraced = true;
+  }
   if (m_guide) m_guide->setRecording(training);
   m_integrator->renderPass(m_settings.sampleOffset + m_samples, samples);
   m_samples += samples;

@@ -136,6 +136,7 @@ class Renderer {
   RenderSettings m_settings;
   SceneSummary m_summary;
   std::uint32_t m_samples = 0;
+  bool m_photonsTraced = false;  // the guide's photon pre-pass ran (renderPass)
   std::uint32_t m_guideSamples = 0;  // samples the guide has seen (renderPass): not reset by reset()
   std::uint32_t m_samplesPerPass = 1;
   Camera m_camera;
