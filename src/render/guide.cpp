@@ -112,8 +112,10 @@ void DeviceGuide::endPhotons() {
   const auto t0 = std::chrono::steady_clock::now();
   for (const guiding::IterationReport& r : guiding::trainPhotons(m_tree, m_photons, kPhotonRounds))
     m_reports.push_back(r);
-  m_photons.clear();
-  m_photons.shrink_to_fit();
+  if (!m_keepPhotons) {
+    m_photons.clear();
+    m_photons.shrink_to_fit();
+  }
   upload();
   m_seconds += secondsSince(t0);
 }

@@ -49,6 +49,9 @@ class DeviceGuide {
   void setPhotons(bool on);
   void consumePhotons(std::uint32_t photons);
   void endPhotons();
+  // Tests: keep the photon pre-pass's splats after endPhotons (photonSplats()).
+  void keepPhotonSplats(bool keep) { m_keepPhotons = keep; }
+  const std::vector<guiding::PhotonSplat>& photonSplats() const { return m_photons; }
   // Rounds of the photons' training: the directional trees refined 3 times by their energy.
   static constexpr std::uint32_t kPhotonRounds = 4;
   // The end of training iteration k: refines the tree and uploads the arrays the shade stages
@@ -78,6 +81,7 @@ class DeviceGuide {
   vk::Buffer m_records;  // capacity x recordsPerPath x GUIDE_RECORD_VEC4S vec4
   std::vector<glm::vec4> m_hostRecords, m_hostRadiance;
   std::vector<guiding::PhotonSplat> m_photons;  // the pre-pass's splats until endPhotons
+  bool m_keepPhotons = false;
   std::vector<guiding::IterationReport> m_reports;
   double m_seconds = 0;
   std::uint64_t m_hash = 0;

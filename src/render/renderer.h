@@ -100,6 +100,7 @@ class Renderer {
   const SceneSummary& summary() const { return m_summary; }
   // Path guiding's state (null for unguided renders): its training reports and times.
   const DeviceGuide* guide() const { return m_guide.get(); }
+  DeviceGuide* guide() { return m_guide.get(); }
   // Path guiding: the samples per pixel the guide has trained on so far (at most the training
   // spp), across resets; 0 for unguided renders.
   std::uint32_t guideTrainedSpp() const {
