@@ -239,8 +239,9 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, b
   // All queues start empty (counts and dispatch sizes).
   vkCmdFillBuffer(cmd, m_queues->buffer, 0, QUEUE_HEADER_UINTS * 4, 0);
   vkCmdFillBuffer(cmd, m_args->buffer, 0, VK_WHOLE_SIZE, 0);
-  // Path guiding's training records start as "ended here" (guiding_layout.h).
-  if (m_guide && m_guide->recording()) vkCmdFillBuffer(cmd, m_guide->records().buffer, 0, VK_WHOLE_SIZE, 0);
+  // Path guiding's training records (and the photon pre-pass's) start as "ended here"
+  // (guiding_layout.h).
+  if (m_guide && (m_guide->recording() || start)) vkCmdFillBuffer(cmd, m_guide->records().buffer, 0, VK_WHOLE_SIZE, 0);
   vk::computeBarrier(cmd);
 
   BounceConstants pc{};
