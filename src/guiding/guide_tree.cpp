@@ -178,8 +178,8 @@ void GuideTree::splatDirection(std::uint32_t leafIndex, glm::vec3 d, double valu
   else t.splat(p, value);
 }
 
-void GuideTree::splatAt(std::uint32_t leafIndex, glm::vec3 x, glm::vec3 d, double value) {
-  m_leaves[leafIndex].samples += 1;
+void GuideTree::splatAt(std::uint32_t leafIndex, glm::vec3 x, glm::vec3 d, double value, double count) {
+  m_leaves[leafIndex].samples += count;
   ++m_splats;
   if (!(value > 0) || !std::isfinite(value)) return;
   if (!m_settings.spatialFilter || m_leaves.size() == 1) {
@@ -446,10 +446,10 @@ void appendPhotons(const glm::vec4* records, std::uint32_t recordsPerPath, std::
 }
 
 std::vector<IterationReport> trainPhotons(GuideTree& tree, const std::vector<PhotonSplat>& splats,
-                                          std::uint32_t rounds) {
+                                          std::uint32_t rounds, double count) {
   std::vector<IterationReport> reports;
   for (std::uint32_t round = 0; round < rounds; ++round) {
-    for (const PhotonSplat& s : splats) tree.splat(s.x, s.d, double(s.value));
+    for (const PhotonSplat& s : splats) tree.splat(s.x, s.d, double(s.value), count);
     reports.push_back(tree.endIteration(0));
     reports.back().iteration = round;
     reports.back().photons = true;

@@ -169,9 +169,11 @@ class GuideTree {
   // density per steradian with which d was sampled; counts one sample of x's leaf.
   // With the settings' filters: shared among the regions around x (spatialFilter) and the cells
   // around d (dirFilter); the splat counts of x's own leaf.
-  void splat(glm::vec3 x, glm::vec3 d, double value) { splatAt(findLeaf(x), x, d, value); }
+  // count: what the splat adds to its leaf's count for the split rule (1; the photon pre-pass's
+  // splats count less: trainPhotons).
+  void splat(glm::vec3 x, glm::vec3 d, double value, double count = 1.0) { splatAt(findLeaf(x), x, d, value, count); }
   // The same for a vertex x known to lie in leaf `leaf` (findLeaf(x)).
-  void splatAt(std::uint32_t leaf, glm::vec3 x, glm::vec3 d, double value);
+  void splatAt(std::uint32_t leaf, glm::vec3 x, glm::vec3 d, double value, double count = 1.0);
   // A vertex of leaf `leaf` sampled by the mixture: y = its estimate through the sample (the
   // radiance it carried, >= 0), pdfGuide and pdfBsdf = the guide's and the BRDF sampler's
   // densities at the sampled direction, alpha = the selection probability it was drawn with.
@@ -250,9 +252,9 @@ void appendPhotons(const glm::vec4* records, std::uint32_t recordsPerPath, std::
 // The photons' guide: `rounds` times, every splat in order into the building trees, then
 // endIteration(0) (spatial split by their count, directional refinement by their energy): the
 // sampling trees end as the photons' energy in a structure refined rounds - 1 times by it (a
-// single round leaves them at the initial structure, one node per region). One report per round,
-// photons = true.
+// single round leaves them at the initial structure, one node per region). Each splat counts
+// `count` towards the spatial split rule. One report per round, photons = true.
 std::vector<IterationReport> trainPhotons(GuideTree& tree, const std::vector<PhotonSplat>& splats,
-                                          std::uint32_t rounds);
+                                          std::uint32_t rounds, double count = 1.0);
 
 }  // namespace nusselt::guiding

@@ -108,9 +108,9 @@ void DeviceGuide::consumePhotons(std::uint32_t photons) {
   m_seconds += secondsSince(t0);
 }
 
-void DeviceGuide::endPhotons() {
+void DeviceGuide::endPhotons(double countWeight) {
   const auto t0 = std::chrono::steady_clock::now();
-  for (const guiding::IterationReport& r : guiding::trainPhotons(m_tree, m_photons, kPhotonRounds))
+  for (const guiding::IterationReport& r : guiding::trainPhotons(m_tree, m_photons, kPhotonRounds, countWeight))
     m_reports.push_back(r);
   if (!m_keepPhotons) {
     m_photons.clear();

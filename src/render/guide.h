@@ -48,7 +48,8 @@ class DeviceGuide {
   // from them (guiding::trainPhotons, kPhotonRounds rounds, reported with photons = true).
   void setPhotons(bool on);
   void consumePhotons(std::uint32_t photons);
-  void endPhotons();
+  // countWeight: what each photon splat counts towards the spatial split rule.
+  void endPhotons(double countWeight = 1.0);
   // Tests: keep the photon pre-pass's splats after endPhotons (photonSplats()).
   void keepPhotonSplats(bool keep) { m_keepPhotons = keep; }
   const std::vector<guiding::PhotonSplat>& photonSplats() const { return m_photons; }
