@@ -358,3 +358,97 @@ TEST(Guiding, PhotonRecordsLandWhereLightArrivesIndirectly) {
   EXPECT_LT(originChi2, kCritical);
   EXPECT_EQ(test::validationMessages(), 0u);
 }
+
+// The same for a point light (intensity 1, luminance 1) at height 1 between the floor and the
+// ceiling, no other light: photons leave in uniform directions, half of them up to the ceiling and
+// half down to the floor (direct light, not recorded); after one bounce the first arrive on the
+// floor, the others on the ceiling (half each: a z-test). Every record must lie on one of the two (at most the 0.999
+// quantile of Binomial(n, 1e-5) elsewhere: nothing else is there), point towards the other, have
+// d.y^2 uniform (the Lambert bounce, reversed), lead back to a point whose horizontal distance r
+// from the light has 1 / sqrt(1 + r^2) = |cos| of the emission angle uniform (uniform directions
+// from height 1), and carry I 4 pi rho = 2 pi (luminance; one light, selected with probability 1).
+// Uniform emission sends 5 % of the photons beyond r = 20, where the planes' edges (100) let a
+// share of them or of their bounces escape: both chi-square tests take only the records that lead
+// back to r <= 20 (directions: 20 bins; origins: the 19 bins of u in [0.05, 1]), significance 0.001.
+TEST(Guiding, PhotonRecordsFromAPointLight) {
+  Scene scene;
+  scene.materials.push_back(catalogueMaterial("lambert", {{"rho", ParamValue::num(0.5)}}, "white", glm::vec3(0.0f)));
+  const float W = 100.0f;
+  test::addQuad(scene, {-W, 0, -W}, {-W, 0, W}, {W, 0, W}, {W, 0, -W}, 0);  // floor, normal +y
+  test::addQuad(scene, {-W, 2, -W}, {W, 2, -W}, {W, 2, W}, {-W, 2, W}, 0);  // ceiling, normal -y
+  PunctualLight point;
+  point.type = LightType::Point;
+  point.position = {0.0f, 1.0f, 0.0f};
+  point.intensity = glm::vec3(1.0f);
+  scene.lights.push_back(point);
+  scene.hasCamera = true;
+  scene.camera.position = {0.0f, 0.5f, -3.0f};
+  scene.camera.forward = {0.0f, 0.0f, 1.0f};
+  scene.camera.up = {0.0f, 1.0f, 0.0f};
+  RenderSettings s;
+  s.width = s.height = 8;
+  s.spp = 2;
+  s.maxDepth = 1;
+  s.seed = 10;
+  s.sampler = SamplerKind::Cosine;
+  s.guiding = true;
+  s.guidePhotons = 100000;
+  Renderer r(test::context(), scene, s);
+  ASSERT_NE(r.guide(), nullptr);
+  r.guide()->keepPhotonSplats(true);
+  r.render(1);
+  const std::vector<guiding::PhotonSplat>& splats = r.guide()->photonSplats();
+  const std::uint32_t n = static_cast<std::uint32_t>(splats.size());
+  ASSERT_GT(n, 90000u) << "nearly every photon must arrive on the floor or the ceiling after its bounce";
+  constexpr int kBins = 20;
+  constexpr double kCritical = 43.82;  // chi-square, 19 degrees of freedom, significance 0.001
+  std::vector<double> dirBins(kBins, 0), originBins(kBins, 0);
+  std::uint32_t elsewhere = 0, away = 0, offValue = 0, onFloor = 0, far = 0;
+  const double value = 4.0 * 3.14159265358979 * 0.5;
+  for (const guiding::PhotonSplat& p : splats) {
+    const bool floor = std::fabs(p.x.y) < 1e-3f, ceiling = std::fabs(p.x.y - 2.0f) < 1e-3f;
+    if (!floor && !ceiling) {
+      ++elsewhere;
+      continue;
+    }
+    onFloor += floor ? 1 : 0;
+    if (floor ? !(p.d.y > 0.0f) : !(p.d.y < 0.0f)) {
+      ++away;
+      continue;
+    }
+    const double t = (floor ? 2.0 : 0.0) - p.x.y;  // to the other plane
+    const glm::dvec3 o = glm::dvec3(p.x) + t / p.d.y * glm::dvec3(p.d);
+    const double u = 1.0 / std::sqrt(1.0 + o.x * o.x + o.z * o.z);
+    if (u < 0.05) {  // r > 20: bounced where the planes' edges let some escape
+      ++far;
+      continue;
+    }
+    const double c2 = double(p.d.y) * p.d.y;
+    dirBins[std::min(kBins - 1, int(c2 * kBins))] += 1;
+    originBins[std::min(kBins - 1, int(u * kBins))] += 1;
+    if (std::fabs(p.value / value - 1.0) > 1e-4) ++offValue;
+  }
+  EXPECT_LE(elsewhere, static_cast<std::uint32_t>(test::binomialUpperLimit(int(n), 1e-5, 0.001)));
+  EXPECT_EQ(away, 0u) << "records whose direction points away from the plane they came from";
+  EXPECT_EQ(offValue, 0u) << "records whose value is not the photon's power (expected " << value << ")";
+  // Equal bins from bin `first` on (the origins' bin 0, u < 0.05, is left out).
+  auto chi2 = [&](const std::vector<double>& bins, int first) {
+    double total = 0, x = 0;
+    for (int b = first; b < kBins; ++b) total += bins[b];
+    const double e = total / (kBins - first);
+    for (int b = first; b < kBins; ++b) x += (bins[b] - e) * (bins[b] - e) / e;
+    return x;
+  };
+  constexpr double kCritical18 = 42.31;  // 18 degrees of freedom, significance 0.001
+  const double dirChi2 = chi2(dirBins, 0), originChi2 = chi2(originBins, 1);
+  std::printf("point-light photon records: %u, %u on the floor, %u elsewhere, %u from r > 20; chi-square directions "
+              "%.2f (critical %.2f), origins %.2f (critical %.2f)\n",
+              n, onFloor, elsewhere, far, dirChi2, kCritical, originChi2, kCritical18);
+  EXPECT_LT(dirChi2, kCritical);
+  EXPECT_LT(originChi2, kCritical18);
+  // Up and down alike: the floor's share of the records is 1/2 (the geometry is symmetric about
+  // the light's plane), two-sided z-test at significance 0.001.
+  const double zFloor = (onFloor - 0.5 * n) / (0.5 * std::sqrt(double(n)));
+  EXPECT_LT(std::fabs(zFloor), 3.29) << "floor records " << onFloor << " of " << n;
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
