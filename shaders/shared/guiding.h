@@ -203,6 +203,23 @@ bool guideSampleLocal(GuideVertex v, float uDescent, PathKey k, uint bounce, vec
 // Whether this pass writes training records (the guide's info.x).
 bool guideRecording() { return g.guide.v[0].info.x > 0u; }
 
+// Whether this pass traces photons (the guide's info.y: the photon pre-pass, docs/guiding.md): the
+// paths start at light samples (photon.comp), the shade stages write photon records and neither
+// gather emission nor sample lights, the escape stage does nothing.
+bool guidePhotons() { return g.guide.v[0].info.y != 0u; }
+
+// Photon record k = bounce of this photon (guiding_layout.h, "Photon records"): it arrived at x
+// from the world direction wFrom (unit, towards where it came from) carrying power of luminance
+// value (> 0).
+void guideRecordPhoton(uint path, uint bounce, vec3 x, vec3 wFrom, float value) {
+  uint n = g.guide.v[0].info.x;
+  if (bounce >= n) return;
+  GuideRecords R = g.guide.v[0].records;
+  uint i = (path * n + bounce) * GUIDE_RECORD_VEC4S;
+  R.v[i] = vec4(x, value);
+  R.v[i + 1u] = vec4(wFrom, 1.0f);
+}
+
 // Training record k = bounce of this path (guiding_layout.h): its ray arrived at x with the path
 // radiance as it stands (call before the stage adds anything); the path ends here unless
 // guideRecordSample follows.
@@ -238,6 +255,8 @@ bool guideSampleLocal(GuideVertex v, float uDescent, PathKey k, uint bounce, vec
   return false;
 }
 bool guideRecording() { return false; }
+bool guidePhotons() { return false; }
+void guideRecordPhoton(uint path, uint bounce, vec3 x, vec3 wFrom, float value) {}
 void guideRecordArrival(uint path, uint bounce, vec3 x) {}
 void guideRecordSample(uint path, uint bounce, vec3 wi, float value, vec3 selection) {}
 #endif

@@ -70,9 +70,14 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer GuideRecord
 // the density (src/guiding/guide_tree.cpp, splatPaths); c lets the trainer estimate, per region,
 // the second moment the vertex's estimate would have under another alpha (GuideTree,
 // observeSelection).
+// Photon records (the photon pre-pass, info.y = 1; the same buffer and slots, path = photon):
+// record k of photon p, written by the shade stage where the photon's ray of bounce k arrived
+// (k >= 1: after at least one bounce off a surface, indirect light; k = 0, direct light, is NEE's):
+//   a = (position (xyz), luminance of the photon's power on arrival);
+//   b = (unit world direction towards where it came from, 1); b.w = 0: no record.
 #define GUIDE_RECORD_VEC4S 3u
 // boundsMin, boundsMax: the spatial tree's root box (w unused);
-// info = (records per path, 0: not recording; 0, 0, 0).
+// info = (records per path, 0: not recording; 1: the photon pre-pass, else 0; 0, 0).
 struct GpuGuide {
   vec4 boundsMin;
   vec4 boundsMax;

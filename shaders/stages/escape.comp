@@ -13,6 +13,7 @@ void main() {
   uint idx = gl_GlobalInvocationID.x;
   if (idx >= queueCount(QUEUE_ESCAPE)) return;
   uint path = queueItem(QUEUE_ESCAPE, idx);
+  if (GUIDING && guidePhotons()) return;  // a photon that left the scene: nothing to record
   if (GUIDING) guideRecordArrival(path, pc.bounce, vec3(0.0f));  // training record (guiding.h)
   vec4 rayD = g.pathDirection.v[path];
   vec3 dir = rayD.xyz;

@@ -535,7 +535,8 @@ void continuePath(PathStep s, uint path, uint bounce, uint roulette, vec3 x, vec
     if (transmitted) etaScale *= s.etaScale;
     if (!throughputRoulette(bounce, beta, etaScale, uR)) return;
   }
-  if (GUIDING) guideRecordSample(path, bounce, wi, s.delta ? -1.0f : luminance(beta) * s.pdf, s.selection);
+  if (GUIDING && !guidePhotons())
+    guideRecordSample(path, bounce, wi, s.delta ? -1.0f : luminance(beta) * s.pdf, s.selection);
   g.pathOrigin.v[path] = vec4(xo, 0.0f);
   g.pathDirection.v[path] = vec4(wi, s.pdf);
   g.pathThroughput.v[path] = vec4(beta, etaScale);
@@ -580,16 +581,25 @@ void main() {
   vec3 beta = throughput.xyz;
   float etaScale = throughput.w;
   vec3 L = vec3(0.0f);
-  if (GUIDING) guideRecordArrival(path, bounce, x);  // training record (guiding.h)
+  // The guide's photon pre-pass (guidePhotons, docs/guiding.md): this path is a photon whose
+  // throughput is its power over the scale in its radiance's w (photon.comp).
+  bool photon = GUIDING && guidePhotons();
+  if (GUIDING && !photon) guideRecordArrival(path, bounce, x);  // training record (guiding.h)
   bool frontFace = dot(ngFront, dir) < 0.0f;
 
   // ---- Beer-Lambert: a ray that meets an absorbing material from the back came from inside ----
   // (shared/volume.h; docs/scenes.md, "Volumes"): the segment of length hit.x (dir is a unit
   // vector) is attenuated before anything at this vertex counts.
   if ((M.info.y & MATERIAL_ABSORBING) != 0u && !frontFace) beta *= volumeTransmittance(M.absorption.xyz, hit.x);
+  // A photon's arrival after at least one bounce (indirect light; NEE keeps the direct) is a
+  // training record: where, from where, the luminance of its power.
+  if (photon && bounce >= 1u) {
+    float power = luminance(beta) * g.pathRadiance.v[path].w;
+    if (power > 0.0f && isFinite(power)) guideRecordPhoton(path, bounce, x, -dir, power);
+  }
 
   // ---- Emission: one-sided emitters radiate along their geometric normal ----
-  if ((M.info.y & MATERIAL_EMISSIVE) != 0u && frontFace) {
+  if ((M.info.y & MATERIAL_EMISSIVE) != 0u && frontFace && !photon) {
     float w = 1.0f;
     if (bounce > 0u && prevPdf > 0.0f) {  // reached by a BSDF sample that light sampling could also make
       if (lighting == LIGHTING_NEE_ONLY) {
@@ -619,7 +629,7 @@ void main() {
   bool last = bounce >= g.maxDepth;
 
   ShadeMaterial m = shadeMaterial(M, x, wo, roulette, ShadeHit(S.info.x, tri, hit.y, hit.z), !frontFace);
-  if (!last && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m))
+  if (!last && !photon && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m))
     nextEvent(m, path, key, bounce, lighting, x, xo, ng, tt, bb, ns, wo, beta);
 
   g.pathRadiance.v[path].xyz += L;

@@ -74,6 +74,7 @@ struct RenderArgs {
   std::string guideFilter = "box";
   std::string guideSpatialFilter = "none";
   double guideFloor = 0.0;
+  std::uint32_t guidePhotons = 0;
   bool variance = false;
   bool validation = false;
   bool quiet = false;
@@ -138,6 +139,7 @@ int renderCommand(const RenderArgs& a) {
   s.guideDirFilter = a.guideFilter == "box";
   s.guideSpatialFilter = a.guideSpatialFilter == "box";
   s.guideFloor = a.guideFloor;
+  s.guidePhotons = a.guidePhotons;
   // What Metropolis renders do not support (docs/mlt.md): guiding and the variance of a correlated
   // estimate. A resumed one restarts its chains from a new bootstrap (docs/mlt.md, "Resume").
   if (s.integrator == IntegratorKind::Mlt) {
@@ -202,6 +204,8 @@ int renderCommand(const RenderArgs& a) {
       if (p.guideSpatialFilter != s.guideSpatialFilter)
         refuse("--guide-spatial-filter", box(p.guideSpatialFilter), box(s.guideSpatialFilter));
       if (p.guideFloor != s.guideFloor) refuse("--guide-floor", formatNumber(p.guideFloor), formatNumber(s.guideFloor));
+      if (p.guidePhotons != s.guidePhotons)
+        refuse("--guide-photons", std::to_string(p.guidePhotons), std::to_string(s.guidePhotons));
       s.guideTrainSpp = base.settings.guideTrainSpp = p.guideTrainSpp;
       s.guideTrainPass = base.settings.guideTrainPass = p.guideTrainPass;  // the passes it trained in
     }
@@ -309,9 +313,9 @@ int renderCommand(const RenderArgs& a) {
     RenderRecord rec = loop.record(false);
     if (const DeviceGuide* guide = renderer.guide(); guide && !a.quiet) {
       for (const guiding::IterationReport& r : guide->reports())
-        std::fprintf(stderr, "guiding: iteration %u: %llu splats; %u regions, %llu direction nodes, %.2f MiB of %.2f MiB "
+        std::fprintf(stderr, "guiding: iteration %s: %llu splats; %u regions, %llu direction nodes, %.2f MiB of %.2f MiB "
                              "(rho %g)%s; the guide sampled in %u regions (mean alpha %.3f)\n",
-                     r.iteration, static_cast<unsigned long long>(r.splats), r.leaves,
+                     (r.photons ? "photons " + std::to_string(r.iteration) : std::to_string(r.iteration)).c_str(), static_cast<unsigned long long>(r.splats), r.leaves,
                      static_cast<unsigned long long>(r.dirNodes), r.bytes / 1048576.0, s.guideMemory / 1048576.0,
                      r.dirThreshold, r.capped ? ", memory cap reached" : "", r.guidedLeaves, r.meanAlpha);
       std::fprintf(stderr, "guiding: %u training spp, %.3f s of CPU time reading records, splatting and refining\n",
@@ -877,6 +881,10 @@ int runCli(int argc, char** argv) {
   render->add_option("--guide-floor", ra.guideFloor, "Weight of the uniform sphere density mixed into the learned "
                                                      "guide (0: none)")
       ->capture_default_str()->check(CLI::Range(0.0, 0.5));
+  render->add_option("--guide-photons", ra.guidePhotons, "Photons of the guide's pre-pass: traced from the lights before "
+                                                         "training, their indirect arrivals train the guide of the first "
+                                                         "iteration (0: none; docs/guiding.md)")
+      ->capture_default_str()->check(CLI::Range(0u, 1u << 30));
   render->add_flag("--variance", ra.variance, "Also write the per-pixel variance of the mean (channels var.R, var.G, var.B)");
   render->add_flag("--validation", ra.validation, "Enable the Vulkan validation layer (also NUSSELT_VALIDATION=1); any message fails the render");
   render->add_flag("-q,--quiet", ra.quiet, "No progress or summary output");

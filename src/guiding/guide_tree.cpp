@@ -178,8 +178,8 @@ void GuideTree::splatDirection(std::uint32_t leafIndex, glm::vec3 d, double valu
   else t.splat(p, value);
 }
 
-void GuideTree::splatAt(std::uint32_t leafIndex, glm::vec3 x, glm::vec3 d, double value) {
-  m_leaves[leafIndex].samples += 1;
+void GuideTree::splatAt(std::uint32_t leafIndex, glm::vec3 x, glm::vec3 d, double value, double count) {
+  m_leaves[leafIndex].samples += count;
   ++m_splats;
   if (!(value > 0) || !std::isfinite(value)) return;
   if (!m_settings.spatialFilter || m_leaves.size() == 1) {
@@ -430,6 +430,31 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
     }
   }
   return splats;
+}
+
+void appendPhotons(const glm::vec4* records, std::uint32_t recordsPerPath, std::uint32_t photons,
+                   std::vector<PhotonSplat>& out) {
+  constexpr std::uint32_t R = GUIDE_RECORD_VEC4S;
+  for (std::uint32_t p = 0; p < photons; ++p) {
+    const glm::vec4* r = records + std::size_t(p) * recordsPerPath * R;
+    for (std::uint32_t k = 1; k < recordsPerPath; ++k) {
+      const glm::vec4 a = r[R * k], b = r[R * k + 1];
+      if (b.w != 1.0f || !(a.w > 0.0f) || !std::isfinite(a.w)) continue;
+      out.push_back({glm::vec3(a), glm::vec3(b), a.w});
+    }
+  }
+}
+
+std::vector<IterationReport> trainPhotons(GuideTree& tree, const std::vector<PhotonSplat>& splats,
+                                          std::uint32_t rounds, double count) {
+  std::vector<IterationReport> reports;
+  for (std::uint32_t round = 0; round < rounds; ++round) {
+    for (const PhotonSplat& s : splats) tree.splat(s.x, s.d, double(s.value), count);
+    reports.push_back(tree.endIteration(0));
+    reports.back().iteration = round;
+    reports.back().photons = true;
+  }
+  return reports;
 }
 
 }  // namespace nusselt::guiding

@@ -157,6 +157,7 @@ struct IterationReport {
   bool capped = false;              // the memory cap stopped a split or raised rho
   std::uint32_t guidedLeaves = 0;   // regions sampling the guide (alpha > 0 and a trained tree)
   double meanAlpha = 0;             // their mean alpha
+  bool photons = false;             // the photon pre-pass's splats (before iteration 0)
 };
 
 class GuideTree {
@@ -168,9 +169,11 @@ class GuideTree {
   // density per steradian with which d was sampled; counts one sample of x's leaf.
   // With the settings' filters: shared among the regions around x (spatialFilter) and the cells
   // around d (dirFilter); the splat counts of x's own leaf.
-  void splat(glm::vec3 x, glm::vec3 d, double value) { splatAt(findLeaf(x), x, d, value); }
+  // count: what the splat adds to its leaf's count for the split rule (1; the photon pre-pass's
+  // splats count less: trainPhotons).
+  void splat(glm::vec3 x, glm::vec3 d, double value, double count = 1.0) { splatAt(findLeaf(x), x, d, value, count); }
   // The same for a vertex x known to lie in leaf `leaf` (findLeaf(x)).
-  void splatAt(std::uint32_t leaf, glm::vec3 x, glm::vec3 d, double value);
+  void splatAt(std::uint32_t leaf, glm::vec3 x, glm::vec3 d, double value, double count = 1.0);
   // A vertex of leaf `leaf` sampled by the mixture: y = its estimate through the sample (the
   // radiance it carried, >= 0), pdfGuide and pdfBsdf = the guide's and the BRDF sampler's
   // densities at the sampled direction, alpha = the selection probability it was drawn with.
@@ -235,5 +238,23 @@ class GuideTree {
 // paths in order, and gives each mixture vertex to observeSelection. Returns the number of splats.
 std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_t recordsPerPath,
                          const glm::vec4* pathRadiance, std::uint32_t paths);
+
+// The photon pre-pass (docs/guiding.md, "Photon pre-pass"): one photon's arrival after a bounce.
+struct PhotonSplat {
+  glm::vec3 x;      // where it arrived
+  glm::vec3 d;      // unit direction towards where it came from
+  float value = 0;  // luminance of its power
+};
+// Appends the photon records of `photons` photons (guiding_layout.h, "Photon records":
+// recordsPerPath records per photon) to out, photons in order, records k = 1, 2, ... in order.
+void appendPhotons(const glm::vec4* records, std::uint32_t recordsPerPath, std::uint32_t photons,
+                   std::vector<PhotonSplat>& out);
+// The photons' guide: `rounds` times, every splat in order into the building trees, then
+// endIteration(0) (spatial split by their count, directional refinement by their energy): the
+// sampling trees end as the photons' energy in a structure refined rounds - 1 times by it (a
+// single round leaves them at the initial structure, one node per region). Each splat counts
+// `count` towards the spatial split rule. One report per round, photons = true.
+std::vector<IterationReport> trainPhotons(GuideTree& tree, const std::vector<PhotonSplat>& splats,
+                                          std::uint32_t rounds, double count = 1.0);
 
 }  // namespace nusselt::guiding

@@ -93,6 +93,33 @@ void DeviceGuide::setRecording(bool on) {
   info->info.x = on ? m_recordsPerPath : 0u;
 }
 
+void DeviceGuide::setPhotons(bool on) {
+  auto* info = static_cast<GpuGuide*>(m_info.mapped);
+  info->info.x = on || m_recording ? m_recordsPerPath : 0u;
+  info->info.y = on ? 1u : 0u;
+}
+
+void DeviceGuide::consumePhotons(std::uint32_t photons) {
+  if (photons == 0) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  m_hostRecords.resize(std::size_t(photons) * m_recordsPerPath * GUIDE_RECORD_VEC4S);
+  vk::downloadBuffer(m_ctx, m_records, m_hostRecords.data(), m_hostRecords.size() * sizeof(glm::vec4));
+  guiding::appendPhotons(m_hostRecords.data(), m_recordsPerPath, photons, m_photons);
+  m_seconds += secondsSince(t0);
+}
+
+void DeviceGuide::endPhotons(double countWeight) {
+  const auto t0 = std::chrono::steady_clock::now();
+  for (const guiding::IterationReport& r : guiding::trainPhotons(m_tree, m_photons, kPhotonRounds, countWeight))
+    m_reports.push_back(r);
+  if (!m_keepPhotons) {
+    m_photons.clear();
+    m_photons.shrink_to_fit();
+  }
+  upload();
+  m_seconds += secondsSince(t0);
+}
+
 void DeviceGuide::consumeChunk(const vk::Buffer& pathRadiance, std::uint32_t paths) {
   if (!m_recording || paths == 0) return;
   const auto t0 = std::chrono::steady_clock::now();

@@ -42,6 +42,19 @@ class DeviceGuide {
   // After a chunk of `paths` paths (recording): splats their records with their final radiance
   // (the path radiance buffer).
   void consumeChunk(const vk::Buffer& pathRadiance, std::uint32_t paths);
+  // The photon pre-pass (docs/guiding.md): setPhotons(true) makes the stages trace photons and
+  // write photon records (the GpuGuide's info = (records per path, 1)); consumePhotons splats a
+  // chunk's photon records in photon order; endPhotons trains the tree the first iteration samples
+  // from them (guiding::trainPhotons, kPhotonRounds rounds, reported with photons = true).
+  void setPhotons(bool on);
+  void consumePhotons(std::uint32_t photons);
+  // countWeight: what each photon splat counts towards the spatial split rule.
+  void endPhotons(double countWeight = 1.0);
+  // Tests: keep the photon pre-pass's splats after endPhotons (photonSplats()).
+  void keepPhotonSplats(bool keep) { m_keepPhotons = keep; }
+  const std::vector<guiding::PhotonSplat>& photonSplats() const { return m_photons; }
+  // Rounds of the photons' training: the directional trees refined 3 times by their energy.
+  static constexpr std::uint32_t kPhotonRounds = 4;
   // The end of training iteration k: refines the tree and uploads the arrays the shade stages
   // sample from next.
   void endIteration(std::uint32_t iteration);
@@ -68,6 +81,8 @@ class DeviceGuide {
   vk::Buffer m_arrays;   // spatial nodes then directional nodes (the cap's bytes)
   vk::Buffer m_records;  // capacity x recordsPerPath x GUIDE_RECORD_VEC4S vec4
   std::vector<glm::vec4> m_hostRecords, m_hostRadiance;
+  std::vector<guiding::PhotonSplat> m_photons;  // the pre-pass's splats until endPhotons
+  bool m_keepPhotons = false;
   std::vector<guiding::IterationReport> m_reports;
   double m_seconds = 0;
   std::uint64_t m_hash = 0;

@@ -116,7 +116,7 @@ PathIntegrator::~PathIntegrator() {
   vkDeviceWaitIdle(d);
   vk::destroyRecorder(m_ctx, m_recorder);
   if (m_queryPool) vkDestroyQueryPool(d, m_queryPool, nullptr);
-  for (auto* p : {&m_camera, &m_intersect, &m_escape, &m_accumulate})
+  for (auto* p : {&m_camera, &m_intersect, &m_escape, &m_accumulate, &m_photon})
     if (p->pipeline) vk::destroyComputePipeline(m_ctx, *p);
   for (auto& p : m_shade) vk::destroyComputePipeline(m_ctx, p);
   for (auto& b : m_buffers) vk::destroyBuffer(m_ctx, b);
@@ -164,6 +164,7 @@ void PathIntegrator::createPipelines() {
     else m_escape = vk::createComputePipeline(m_ctx, layout, "escape");
   }
   m_accumulate = vk::createComputePipeline(m_ctx, layout, "accumulate");
+  if (m_guide && m_settings.guidePhotons > 0) m_photon = vk::createComputePipeline(m_ctx, layout, "photon");
   // Only the models (and combinations) this scene uses: one specialised shade pipeline each,
   // created on all cores (drivers compile at creation; lavapipe takes ~0.3 s per shade pipeline,
   // single-threaded). Single-model pipelines get exactly (MODEL_ID, SAMPLER); combined ones
@@ -226,7 +227,8 @@ void PathIntegrator::emptyTraceArgs(VkCommandBuffer cmd, std::uint32_t parity) {
   vkCmdFillBuffer(cmd, m_args->buffer, (ARGS_TRACE0 + parity) * sizeof(DispatchArgs), sizeof(DispatchArgs), 0);
 }
 
-void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, bool accumulate) {
+void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, bool accumulate,
+                                const vk::ComputePipeline* start) {
   const std::uint32_t slots = static_cast<std::uint32_t>(m_slotKeys.size());
   const VkPipelineLayout layout = m_globals.layout();
   const VkDescriptorSet set = m_globals.set();
@@ -237,8 +239,9 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, b
   // All queues start empty (counts and dispatch sizes).
   vkCmdFillBuffer(cmd, m_queues->buffer, 0, QUEUE_HEADER_UINTS * 4, 0);
   vkCmdFillBuffer(cmd, m_args->buffer, 0, VK_WHOLE_SIZE, 0);
-  // Path guiding's training records start as "ended here" (guiding_layout.h).
-  if (m_guide && m_guide->recording()) vkCmdFillBuffer(cmd, m_guide->records().buffer, 0, VK_WHOLE_SIZE, 0);
+  // Path guiding's training records (and the photon pre-pass's) start as "ended here"
+  // (guiding_layout.h).
+  if (m_guide && (m_guide->recording() || start)) vkCmdFillBuffer(cmd, m_guide->records().buffer, 0, VK_WHOLE_SIZE, 0);
   vk::computeBarrier(cmd);
 
   BounceConstants pc{};
@@ -247,7 +250,7 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, b
     vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
   };
   const std::uint32_t groups = (chunkCount + WORKGROUP_SIZE - 1) / WORKGROUP_SIZE;
-  bindAndPush(m_camera);
+  bindAndPush(start ? *start : m_camera);
   vkCmdDispatch(cmd, groups, 1, 1);
   vk::computeBarrier(cmd);
   mark(cmd, "camera");
@@ -355,6 +358,31 @@ void PathIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples
     if (m_guide && m_guide->recording()) m_guide->consumeChunk(*m_pathRadiance, count);
     foldStats();
   }
+}
+
+void PathIntegrator::photonPass(std::uint32_t photons) {
+  if (!m_guide || !m_photon.pipeline || photons == 0) return;
+  Globals& g = m_globals.host();
+  // The photons draw from their own streams (the seed mixed with a constant): photon p's numbers
+  // are not those of pixel p's samples, which then sample the guide the photons trained.
+  const std::uint32_t seed = g.seed;
+  g.seed = seed ^ 0x6a09e667u;
+  m_guide->setPhotons(true);
+  for (std::uint32_t start = 0; start < photons; start += m_capacity) {
+    const std::uint32_t count = std::min(m_capacity, photons - start);
+    g.chunkFirst = start;
+    g.chunkPaths = count;
+    g.sampleIndex = 0;
+    g.passSamples = 1;
+    m_globals.upload();
+    recordPass(vk::beginRecording(m_ctx, m_recorder), count, false, &m_photon);
+    vk::submitAndWait(m_ctx, m_recorder);
+    m_guide->consumePhotons(count);
+    std::memset(m_stats->mapped, 0, STAT_BUFFER_UINTS * 4);  // not the render's rays
+  }
+  m_guide->setPhotons(false);
+  g.seed = seed;
+  m_globals.upload();
 }
 
 void PathIntegrator::foldStats() {

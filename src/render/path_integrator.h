@@ -66,6 +66,11 @@ class PathIntegrator : public Integrator {
   // For integrators that weigh the traced paths before they reach the film (vegas): records the
   // accumulate stage over path slots 0 .. paths - 1 of the chunk the globals describe.
   void recordAccumulate(VkCommandBuffer cmd, std::uint32_t paths);
+  // The path guide's photon pre-pass (guided renders with settings.guidePhotons > 0): traces
+  // `photons` photons from the lights (photon.comp, the shade stages in photon mode) in chunks of
+  // capacity() and gives each chunk's records to the guide (DeviceGuide::consumePhotons), in photon
+  // order. Its rays are not counted in stats().
+  void photonPass(std::uint32_t photons);
   void foldStats();
   RenderStats stats() const override { return m_totals; }
   void addStats(const RenderStats& carried) override;
@@ -87,7 +92,9 @@ class PathIntegrator : public Integrator {
 
  private:
   void createPipelines();
-  void recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, bool accumulate = true);
+  // start: the stage that starts the paths (the camera's unless given: the photon pass's).
+  void recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, bool accumulate = true,
+                  const vk::ComputePipeline* start = nullptr);
   // Empties queues [first, first + count): their counts and indirect dispatch sizes.
   void emptyQueues(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t count);
   // Empties the trace stage's dispatch size ARGS_TRACE0 + parity.
@@ -109,6 +116,7 @@ class PathIntegrator : public Integrator {
   vk::Buffer* m_stats = nullptr;
 
   vk::ComputePipeline m_camera, m_intersect, m_escape, m_accumulate;
+  vk::ComputePipeline m_photon;  // the guide's photon pre-pass (only when it has photons)
   bool m_hasEscape = false;
   bool m_hasTextures = false;  // spec constant HAS_TEXTURES of the shade stages
   bool m_hasAlpha = false;     // spec constant HAS_ALPHA of the tracing stages

@@ -249,6 +249,17 @@ void Renderer::renderPass(std::uint32_t samples) {
     iterationEnd = std::min((2u << iteration) - 1, trainSpp);
     samples = std::min({samples, iterationEnd - m_guideSamples, m_settings.guideTrainPass});
   }
+  // The photon pre-pass (docs/guiding.md): before the first training iteration, its photons train
+  // the guide that iteration samples (again on a resume: retrainGuide starts from 0 samples).
+  if (training && m_guideSamples == 0 && !m_photonsTraced && m_settings.guidePhotons > 0) {
+    m_paths->photonPass(m_settings.guidePhotons);
+    // The photons split space as a pass of one photon per pixel would (as many paths as the first
+    // iteration's 1 spp): more photons refine the directions, not the regions, which the camera
+    // iterations' splats could not fill.
+    const double pixels = double(m_settings.width) * m_settings.height;
+    m_guide->endPhotons(std::min(1.0, pixels / m_settings.guidePhotons));
+    m_photonsTraced = true;
+  }
   if (m_guide) m_guide->setRecording(training);
   m_integrator->renderPass(m_settings.sampleOffset + m_samples, samples);
   m_samples += samples;

@@ -100,6 +100,7 @@ class Renderer {
   const SceneSummary& summary() const { return m_summary; }
   // Path guiding's state (null for unguided renders): its training reports and times.
   const DeviceGuide* guide() const { return m_guide.get(); }
+  DeviceGuide* guide() { return m_guide.get(); }
   // Path guiding: the samples per pixel the guide has trained on so far (at most the training
   // spp), across resets; 0 for unguided renders.
   std::uint32_t guideTrainedSpp() const {
@@ -136,6 +137,7 @@ class Renderer {
   RenderSettings m_settings;
   SceneSummary m_summary;
   std::uint32_t m_samples = 0;
+  bool m_photonsTraced = false;  // the guide's photon pre-pass ran (renderPass)
   std::uint32_t m_guideSamples = 0;  // samples the guide has seen (renderPass): not reset by reset()
   std::uint32_t m_samplesPerPass = 1;
   Camera m_camera;

@@ -180,6 +180,10 @@ struct RenderSettings {
   bool guideDirFilter = true;
   bool guideSpatialFilter = false;
   double guideFloor = 0.0;
+  // Photons of the guide's pre-pass (`--guide-photons`; 0: none): traced from the lights before
+  // the first training iteration, their arrivals after a bounce train the guide that iteration
+  // samples (docs/guiding.md, "Photon pre-pass").
+  std::uint32_t guidePhotons = 0;
   // The path tracer reads every random number of a path from a primary sample vector in a buffer
   // (PathOptions::primaryDims = PathIntegrator::primaryDimsFor(maxDepth); Renderer::paths()), which
   // the caller fills: for tests of the primary sample source. Not a command-line option.

@@ -72,6 +72,25 @@ else
     fail "guided resume refusal: $(cat "$work/err")"
 fi
 
+# With the photon pre-pass (--guide-photons): the resumed run traces the same photons again before
+# its retraining; a resume with another photon count is refused.
+photons=(--guiding on --guide-train 7 --guide-alpha 0.5 --guide-photons 3000)
+"$nusselt" render "${common[@]}" "${photons[@]}" --spp 12 -o "$work/pfull.exr" || fail "render with photons"
+"$nusselt" render "${common[@]}" "${photons[@]}" --spp 5 -o "$work/p5.exr" || fail "render with photons of 5 spp"
+[ "$(maxdiff "$work/pfull.exr" "$work/gfull.exr")" != 0 ] || fail "the photons did not change the guided render"
+"$nusselt" render --width 24 --height 16 --seed 3 --max-depth 4 "${photons[@]}" --spp 12 --resume "$work/p5.exr" \
+  2>"$work/err" || fail "resume with photons: $(cat "$work/err")"
+grep -q "warning" "$work/err" && fail "resume with photons warns: $(grep warning "$work/err")"
+[ "$(maxdiff "$work/p5.exr" "$work/pfull.exr")" = 0 ] && echo "ok   guided with photons, resumed 5 -> 12 spp equals 12 spp bit for bit" ||
+  fail "resume with photons differs: $("$nusselt" diff "$work/p5.exr" "$work/pfull.exr")"
+"$nusselt" render "${common[@]}" "${photons[@]}" --spp 3 -o "$work/p3.exr" || fail "render with photons of 3 spp"
+if "$nusselt" render "${common[@]}" --guiding on --guide-train 7 --guide-alpha 0.5 --spp 12 --resume "$work/p3.exr" 2>"$work/err"; then
+  fail "resume without the saved render's photons accepted"
+else
+  grep -q -- "--guide-photons was 3000" "$work/err" && echo "ok   resume with another --guide-photons refused: $(cat "$work/err")" ||
+    fail "photon resume refusal: $(cat "$work/err")"
+fi
+
 # Split across two jobs by --spp-offset, merged: the single 6-spp render up to float rounding
 # of the sums (the parts add their sums in another order).
 "$nusselt" render "${common[@]}" --spp 3 --spp-offset 0 -o "$work/a.exr" || fail "job a"

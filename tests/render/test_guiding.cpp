@@ -201,3 +201,254 @@ TEST(Guiding, LearnedAlphaFallsBackToBsdfSamplingInAFurnace) {
   EXPECT_LE(c.guided, bound) << "regions that sample the guide in a furnace, of " << c.learned;
   EXPECT_EQ(test::validationMessages(), 0u);
 }
+
+// ---- The photon pre-pass (--guide-photons; docs/guiding.md, "Photon pre-pass") -----------------------
+
+// Guided renders with photons are unbiased (the guide the first iteration samples comes from the
+// photons; the mixture with the BRDF sampler keeps every estimate unbiased), with the learned and
+// a fixed alpha; and the photons trained a refined guide (more than one directional node per
+// region in their last round).
+TEST(Guiding, UnbiasedWithPhotonPrePass) {
+  const Scene scene = test::loadTestScene("scenes/cornell/cornell-indirect.glb");
+  for (float alpha : {-1.0f, 0.5f}) {
+    SCOPED_TRACE(alpha);
+    RenderSettings s;
+    s.width = s.height = 32;
+    s.spp = 64;
+    s.maxDepth = 6;
+    s.seed = 21;
+    test::Rendered plain = test::render(scene, s);
+    s.seed = 22;
+    s.guiding = true;
+    s.guideAlpha = alpha;
+    s.guidePhotons = 20000;
+    Renderer r(test::context(), scene, s);
+    r.render(s.spp);
+    Image guided = r.image(true);
+    ASSERT_NE(r.guide(), nullptr);
+    const auto& reports = r.guide()->reports();
+    ASSERT_GT(reports.size(), DeviceGuide::kPhotonRounds);
+    const guiding::IterationReport& last = reports[DeviceGuide::kPhotonRounds - 1];
+    ASSERT_TRUE(last.photons);
+    EXPECT_GT(last.splats, 0u) << "the photons must have arrived somewhere after a bounce";
+    EXPECT_GT(last.dirNodes, last.leaves) << "the photons' guide must be refined";
+    if (alpha > 0) EXPECT_GT(last.guidedLeaves, 0u) << "the photons' guide must be sampled";
+    EXPECT_EQ(r.stats().nonFiniteSamples, 0u);
+    // Per block of 4 x 4 pixels: significance 0.01 per block, 0.001 for the binomial bound; the
+    // whole image's mean: two-sided, significance 0.001 (as expectUnbiased).
+    std::string msg = test::compareImagesStatistically(guided, plain.image, 0.01, 0.001, 4);
+    EXPECT_TRUE(msg.empty()) << msg;
+    const double z = meanDifferenceZ(guided, plain.image);
+    EXPECT_GT(test::normalPValue(z), 0.001) << "z = " << z;
+  }
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// The same seed gives the same image with photons (their splats follow the photons' order, their
+// random numbers the seed); and the photons change the image (the first iteration samples their
+// guide: alpha fixed at 0.5).
+TEST(Guiding, SameSeedIsBitIdenticalWithPhotons) {
+  Scene scene = test::loadTestScene("scenes/cornell/cornell-indirect.glb");
+  RenderSettings s;
+  s.width = 24;
+  s.height = 20;
+  s.spp = 16;
+  s.maxDepth = 5;
+  s.seed = 3;
+  s.guiding = true;
+  s.guideAlpha = 0.5f;
+  s.guidePhotons = 5000;
+  s.maxPathsPerChunk = 2048;  // the photons in three chunks
+  test::Rendered a = test::render(scene, s);
+  test::Rendered b = test::render(scene, s);
+  ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
+  EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
+  EXPECT_EQ(a.stats.rays, b.stats.rays);
+  s.guidePhotons = 0;
+  test::Rendered c = test::render(scene, s);
+  EXPECT_NE(0, std::memcmp(a.image.rgb.data(), c.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// Where the photon records land: a tiny Lambert light (1e-3 square, Le = 2) at height 1 facing
+// up, a Lambert ceiling (rho 0.5) at height 2 above it and a floor at 0 (both 200 wide, so
+// that under 1e-3 escapes, and the rays' offset, 1/65536 of the scene's radius, is 2e-3 of the
+// heights), max depth 1: every photon reaches the ceiling (direct light,
+// not recorded), is reflected once, and its only record is its arrival on the floor, the one
+// surface lit indirectly. Checked, with the cosine sampler (so that the ceiling reflects with
+// exactly the cosine density):
+//  - positions: on the floor (y = 0); the light's back, the only other surface below the ceiling,
+//    subtends under 1e-5 of the ceiling's cosine-weighted hemisphere: at most the 0.999 quantile
+//    of Binomial(n, 1e-5) records elsewhere;
+//  - directions, towards where the photon came from: up, with cos^2 = d.y^2 uniform on [0, 1]
+//    (Lambert's reflection at the ceiling, reversed);
+//  - origins: the ceiling point the direction leads back to lies at horizontal distance r from
+//    the light with 1 / (1 + r^2) = cos^2 of the emission angle uniform on [0, 1] (the light's
+//    cosine emission from height 1);
+//  both chi-square tests on 20 equal bins, significance 0.001 each (critical value 43.82, 19
+//  degrees of freedom);
+//  - values: each photon carries Le pi A (two triangles of area A / 2, each selected with
+//    probability 1/2) times rho (the ceiling's weight under cosine sampling; no roulette before
+//    bounce 3): luminance 2 x pi x 1e-6 x 0.5, to 1e-4 relative.
+TEST(Guiding, PhotonRecordsLandWhereLightArrivesIndirectly) {
+  Scene scene;
+  auto lambert = [&](float rho, float le) {
+    scene.materials.push_back(catalogueMaterial("lambert", {{"rho", ParamValue::num(rho)}}, "m", glm::vec3(le)));
+    return std::uint32_t(scene.materials.size() - 1);
+  };
+  const std::uint32_t white = lambert(0.5f, 0.0f), lamp = lambert(0.5f, 2.0f);
+  const float W = 100.0f, h = 5e-4f;
+  test::addQuad(scene, {-W, 0, -W}, {-W, 0, W}, {W, 0, W}, {W, 0, -W}, white);  // floor, normal +y
+  test::addQuad(scene, {-W, 2, -W}, {W, 2, -W}, {W, 2, W}, {-W, 2, W}, white);  // ceiling, normal -y
+  test::addQuad(scene, {-h, 1, -h}, {-h, 1, h}, {h, 1, h}, {h, 1, -h}, lamp);   // light, normal +y
+  scene.hasCamera = true;
+  scene.camera.position = {0.0f, 0.5f, -3.0f};
+  scene.camera.forward = {0.0f, 0.0f, 1.0f};
+  scene.camera.up = {0.0f, 1.0f, 0.0f};
+  RenderSettings s;
+  s.width = s.height = 8;
+  s.spp = 2;  // training 1 spp: the photon pass runs before it
+  s.maxDepth = 1;
+  s.seed = 9;
+  s.sampler = SamplerKind::Cosine;
+  s.guiding = true;
+  s.guidePhotons = 100000;
+  Renderer r(test::context(), scene, s);
+  ASSERT_NE(r.guide(), nullptr);
+  r.guide()->keepPhotonSplats(true);
+  r.render(1);
+  const std::vector<guiding::PhotonSplat>& splats = r.guide()->photonSplats();
+  const std::uint32_t n = static_cast<std::uint32_t>(splats.size());
+  ASSERT_GT(n, 90000u) << "nearly every photon must arrive on the floor after its bounce";
+  constexpr int kBins = 20;
+  constexpr double kCritical = 43.82;  // chi-square, 19 degrees of freedom, significance 0.001
+  std::vector<double> dirBins(kBins, 0), originBins(kBins, 0);
+  std::uint32_t offFloor = 0, down = 0, offValue = 0;
+  const double value = 2.0 * 3.14159265358979 * (2.0 * h) * (2.0 * h) * 0.5;
+  for (const guiding::PhotonSplat& p : splats) {
+    if (std::fabs(p.x.y) > 1e-3f) {
+      ++offFloor;
+      continue;
+    }
+    if (!(p.d.y > 0.0f)) {
+      ++down;
+      continue;
+    }
+    const double c2 = double(p.d.y) * p.d.y;
+    dirBins[std::min(kBins - 1, int(c2 * kBins))] += 1;
+    const glm::dvec3 o = glm::dvec3(p.x) + (2.0 - p.x.y) / p.d.y * glm::dvec3(p.d);
+    const double u = 1.0 / (1.0 + o.x * o.x + o.z * o.z);
+    originBins[std::min(kBins - 1, int(u * kBins))] += 1;
+    if (std::fabs(p.value / value - 1.0) > 1e-4) ++offValue;
+  }
+  const std::uint32_t offBound = static_cast<std::uint32_t>(test::binomialUpperLimit(int(n), 1e-5, 0.001));
+  EXPECT_LE(offFloor, offBound) << "records off the floor";
+  EXPECT_EQ(down, 0u) << "records whose direction points away from the ceiling";
+  EXPECT_EQ(offValue, 0u) << "records whose value is not the photon's power (expected " << value << ")";
+  auto chi2 = [&](const std::vector<double>& bins) {
+    double total = 0, x = 0;
+    for (double b : bins) total += b;
+    for (double b : bins) x += (b - total / kBins) * (b - total / kBins) / (total / kBins);
+    return x;
+  };
+  const double dirChi2 = chi2(dirBins), originChi2 = chi2(originBins);
+  std::printf("photon records: %u on the floor of %u (%u off), chi-square directions %.2f, origins %.2f (critical %.2f)\n",
+              n - offFloor, n, offFloor, dirChi2, originChi2, kCritical);
+  EXPECT_LT(dirChi2, kCritical);
+  EXPECT_LT(originChi2, kCritical);
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
+// The same for a point light (intensity 1, luminance 1) at height 1 between the floor and the
+// ceiling, no other light: photons leave in uniform directions, half of them up to the ceiling and
+// half down to the floor (direct light, not recorded); after one bounce the first arrive on the
+// floor, the others on the ceiling (half each: a z-test). Every record must lie on one of the two (at most the 0.999
+// quantile of Binomial(n, 1e-5) elsewhere: nothing else is there), point towards the other, have
+// d.y^2 uniform (the Lambert bounce, reversed), lead back to a point whose horizontal distance r
+// from the light has 1 / sqrt(1 + r^2) = |cos| of the emission angle uniform (uniform directions
+// from height 1), and carry I 4 pi rho = 2 pi (luminance; one light, selected with probability 1).
+// Uniform emission sends 5 % of the photons beyond r = 20, where the planes' edges (100) let a
+// share of them or of their bounces escape: both chi-square tests take only the records that lead
+// back to r <= 20 (directions: 20 bins; origins: the 19 bins of u in [0.05, 1]), significance 0.001.
+TEST(Guiding, PhotonRecordsFromAPointLight) {
+  Scene scene;
+  scene.materials.push_back(catalogueMaterial("lambert", {{"rho", ParamValue::num(0.5)}}, "white", glm::vec3(0.0f)));
+  const float W = 100.0f;
+  test::addQuad(scene, {-W, 0, -W}, {-W, 0, W}, {W, 0, W}, {W, 0, -W}, 0);  // floor, normal +y
+  test::addQuad(scene, {-W, 2, -W}, {W, 2, -W}, {W, 2, W}, {-W, 2, W}, 0);  // ceiling, normal -y
+  PunctualLight point;
+  point.type = LightType::Point;
+  point.position = {0.0f, 1.0f, 0.0f};
+  point.intensity = glm::vec3(1.0f);
+  scene.lights.push_back(point);
+  scene.hasCamera = true;
+  scene.camera.position = {0.0f, 0.5f, -3.0f};
+  scene.camera.forward = {0.0f, 0.0f, 1.0f};
+  scene.camera.up = {0.0f, 1.0f, 0.0f};
+  RenderSettings s;
+  s.width = s.height = 8;
+  s.spp = 2;
+  s.maxDepth = 1;
+  s.seed = 10;
+  s.sampler = SamplerKind::Cosine;
+  s.guiding = true;
+  s.guidePhotons = 100000;
+  Renderer r(test::context(), scene, s);
+  ASSERT_NE(r.guide(), nullptr);
+  r.guide()->keepPhotonSplats(true);
+  r.render(1);
+  const std::vector<guiding::PhotonSplat>& splats = r.guide()->photonSplats();
+  const std::uint32_t n = static_cast<std::uint32_t>(splats.size());
+  ASSERT_GT(n, 90000u) << "nearly every photon must arrive on the floor or the ceiling after its bounce";
+  constexpr int kBins = 20;
+  constexpr double kCritical = 43.82;  // chi-square, 19 degrees of freedom, significance 0.001
+  std::vector<double> dirBins(kBins, 0), originBins(kBins, 0);
+  std::uint32_t elsewhere = 0, away = 0, offValue = 0, onFloor = 0, far = 0;
+  const double value = 4.0 * 3.14159265358979 * 0.5;
+  for (const guiding::PhotonSplat& p : splats) {
+    const bool floor = std::fabs(p.x.y) < 1e-3f, ceiling = std::fabs(p.x.y - 2.0f) < 1e-3f;
+    if (!floor && !ceiling) {
+      ++elsewhere;
+      continue;
+    }
+    onFloor += floor ? 1 : 0;
+    if (floor ? !(p.d.y > 0.0f) : !(p.d.y < 0.0f)) {
+      ++away;
+      continue;
+    }
+    const double t = (floor ? 2.0 : 0.0) - p.x.y;  // to the other plane
+    const glm::dvec3 o = glm::dvec3(p.x) + t / p.d.y * glm::dvec3(p.d);
+    const double u = 1.0 / std::sqrt(1.0 + o.x * o.x + o.z * o.z);
+    if (u < 0.05) {  // r > 20: bounced where the planes' edges let some escape
+      ++far;
+      continue;
+    }
+    const double c2 = double(p.d.y) * p.d.y;
+    dirBins[std::min(kBins - 1, int(c2 * kBins))] += 1;
+    originBins[std::min(kBins - 1, int(u * kBins))] += 1;
+    if (std::fabs(p.value / value - 1.0) > 1e-4) ++offValue;
+  }
+  EXPECT_LE(elsewhere, static_cast<std::uint32_t>(test::binomialUpperLimit(int(n), 1e-5, 0.001)));
+  EXPECT_EQ(away, 0u) << "records whose direction points away from the plane they came from";
+  EXPECT_EQ(offValue, 0u) << "records whose value is not the photon's power (expected " << value << ")";
+  // Equal bins from bin `first` on (the origins' bin 0, u < 0.05, is left out).
+  auto chi2 = [&](const std::vector<double>& bins, int first) {
+    double total = 0, x = 0;
+    for (int b = first; b < kBins; ++b) total += bins[b];
+    const double e = total / (kBins - first);
+    for (int b = first; b < kBins; ++b) x += (bins[b] - e) * (bins[b] - e) / e;
+    return x;
+  };
+  constexpr double kCritical18 = 42.31;  // 18 degrees of freedom, significance 0.001
+  const double dirChi2 = chi2(dirBins, 0), originChi2 = chi2(originBins, 1);
+  std::printf("point-light photon records: %u, %u on the floor, %u elsewhere, %u from r > 20; chi-square directions "
+              "%.2f (critical %.2f), origins %.2f (critical %.2f)\n",
+              n, onFloor, elsewhere, far, dirChi2, kCritical, originChi2, kCritical18);
+  EXPECT_LT(dirChi2, kCritical);
+  EXPECT_LT(originChi2, kCritical18);
+  // Up and down alike: the floor's share of the records is 1/2 (the geometry is symmetric about
+  // the light's plane), two-sided z-test at significance 0.001.
+  const double zFloor = (onFloor - 0.5 * n) / (0.5 * std::sqrt(double(n)));
+  EXPECT_LT(std::fabs(zFloor), 3.29) << "floor records " << onFloor << " of " << n;
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
