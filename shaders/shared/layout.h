@@ -77,6 +77,15 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 #define LIGHTING_MIS 0u
 #define LIGHTING_NEE_ONLY 1u
 #define LIGHTING_BSDF_ONLY 2u
+// Which part of a path's radiance the stages add (Globals.radiancePart), by the scattering vertices
+// between the light and the camera: emission hit at shade bounce b or escaping after it has b, a
+// light sample (NEE) taken at bounce b has b + 1. Direct light has at most one (emission seen by
+// the camera ray, and NEE and MIS-weighted emitter hits from its first hit), indirect light the
+// rest. The parts use the full estimator's MIS weights, so direct + indirect = all, path by path
+// (Metropolis with direct light outside the chain: docs/mlt.md).
+#define RADIANCE_ALL 0u
+#define RADIANCE_DIRECT 1u
+#define RADIANCE_INDIRECT 2u
 
 // ---- Material flags ---------------------------------------------------------------------------------
 #define MATERIAL_EMISSIVE 1u
@@ -278,7 +287,9 @@ struct GpuMlt {
   BUFREF(Uints) start;
   BUFREF(Uints) counters;
   BUFREF(Uints) extent;
-  uvec2 reserved;  // std430 rounds the struct to 16 bytes
+  // Direct light outside the chain (RenderSettings::mltDirectSpp > 0): (the first direct sample's
+  // number of this trace, direct samples per pixel per iteration); (0, 0): direct light in the chain.
+  uvec2 direct;
 };
 STATIC_ASSERT_SIZE(GpuMlt, 128);
 #ifndef __cplusplus
@@ -383,8 +394,10 @@ struct Globals {
   uint tlasHigh;
   // The roughness bins of the scene's textured gltf_pbr materials (MATERIAL_BINNED; count 0: none).
   RoughnessBins roughnessBins;
+  uint radiancePart;     // RADIANCE_*: every contribution (the default), or only direct or indirect light
+  uint reservedG;
 };
-STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 40 * 8 + 8 + 16);
+STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 40 * 8 + 8 + 16 + 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 
@@ -454,6 +467,11 @@ layout(set = 0, binding = 0, std430) readonly buffer GlobalsBlock { Globals g; }
 #define PRIMARY_BLOCK 8u
 SHARED_FN uint primarySampleIndex(uint path, uint dimension, uint dims) {
   return ((path / PRIMARY_BLOCK) * dims + dimension) * PRIMARY_BLOCK + path % PRIMARY_BLOCK;
+}
+// Whether a contribution with `scatterings` vertices between light and camera belongs to `part`
+// (RADIANCE_*).
+SHARED_FN bool radiancePartKeeps(uint part, uint scatterings) {
+  return part == RADIANCE_ALL || ((part == RADIANCE_DIRECT) == (scatterings <= 1u));
 }
 SHARED_FN uint primarySampleSlots(uint capacity) { return (capacity + PRIMARY_BLOCK - 1u) / PRIMARY_BLOCK * PRIMARY_BLOCK; }
 

@@ -522,7 +522,7 @@ void main() {
         w = powerHeuristic(prevPdf, lightPdf);
       }
     }
-    L += beta * Le * w;
+    if (radiancePartKeeps(g.radiancePart, bounce)) L += beta * Le * w;
   }
 
   // ---- Local frame: surfaces are two-sided, shade the side the ray came from ----
@@ -539,14 +539,17 @@ void main() {
     wo = toLocal(wWorld, tt, bb, ns);
   }
   vec3 xo = offsetRay(x, ng);
-  bool last = bounce >= g.maxDepth;
+  // Direct light only (RADIANCE_DIRECT): nothing after the second vertex counts, so the path ends
+  // there.
+  uint part = g.radiancePart;
+  bool last = bounce >= g.maxDepth || (part == RADIANCE_DIRECT && bounce >= 1u);
 
   float transmissionR = -1.0f;  // the transmission texture at the hit (combined materials only)
 #if SHADE_COMBINED
   if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) transmissionR = transmissionAt(S.info.x, tri, hit.y, hit.z);
 #endif
   ShadeMaterial m = shadeMaterial(M, x, wo, roulette, transmissionR, !frontFace);
-  if (!last && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m))
+  if (!last && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m) && radiancePartKeeps(part, bounce + 1u))
     nextEvent(m, path, key, bounce, lighting, x, xo, ng, tt, bb, ns, wo, beta);
 
   g.pathRadiance.v[path].xyz += L;

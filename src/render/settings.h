@@ -199,6 +199,11 @@ struct RenderSettings {
   // (each large step's path also counts as an independent path-tracer sample, both weighted by
   // 1 / (f / b' + p_large)), or the plain expected-value splats (false). docs/mlt.md.
   bool mltKelemen = true;
+  // Direct light outside the chain (`--mlt-direct-spp`, Mitsuba's directSamples): the chains' f is
+  // the indirect light only (Globals.radiancePart) and every iteration adds this many direct-light-
+  // only path-tracer samples per pixel beside the splats; 0: the whole path contribution is the
+  // chains' f (docs/mlt.md).
+  std::uint32_t mltDirectSpp = 1;
   // VEGAS (--integrator vegas, docs/vegas.md). Bins per warped axis (`--vegas-bins`, 1 .. 4096).
   std::uint32_t vegasBins = 64;
   // Bounces whose light choice, light point and BSDF draws are warped (`--vegas-bounces`, 1 ..
