@@ -184,6 +184,10 @@ struct RenderSettings {
   // (PathOptions::primaryDims = PathIntegrator::primaryDimsFor(maxDepth); Renderer::paths()), which
   // the caller fills: for tests of the primary sample source. Not a command-line option.
   bool primarySamples = false;
+  // The part of each path's radiance the path tracer adds (RADIANCE_*, layout.h: 0 all, 1 direct
+  // light only, 2 indirect light only; Globals.radiancePart). Not a command-line option: for tests
+  // (Metropolis sets its own, mlt_integrator.h).
+  std::uint32_t radiancePart = 0;
   // Metropolis (--integrator mlt, docs/mlt.md). Chains in flight (`--mlt-chains`; each a path slot
   // and a primary sample vector of PathIntegrator::primaryDimsFor(maxDepth) draws).
   std::uint32_t mltChains = 65536;
