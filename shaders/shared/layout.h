@@ -280,6 +280,10 @@ struct GpuMlt {
   // Kelemen's weights: (1 when on, 1 / b' (b' from paths independent of the chains' starts),
   // 1 / b, large-step probability); x = 0: plain expected-value splats.
   vec4 weights;
+  // Direct light outside the chain (RenderSettings::mltDirectSpp > 0): (the number of the first
+  // direct sample of this trace, direct samples per pixel per iteration, direct samples per pixel
+  // in this trace, 0); y = 0: direct light in the chain.
+  uvec4 direct;
   BUFREF(Vec2s) current;
   BUFREF(Vec4s) state;
   BUFREF(Uints) splats;
@@ -287,11 +291,9 @@ struct GpuMlt {
   BUFREF(Uints) start;
   BUFREF(Uints) counters;
   BUFREF(Uints) extent;
-  // Direct light outside the chain (RenderSettings::mltDirectSpp > 0): (the first direct sample's
-  // number of this trace, direct samples per pixel per iteration); (0, 0): direct light in the chain.
-  uvec2 direct;
+  uvec2 reserved;  // std430 rounds the struct to 16 bytes
 };
-STATIC_ASSERT_SIZE(GpuMlt, 128);
+STATIC_ASSERT_SIZE(GpuMlt, 144);
 #ifndef __cplusplus
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Mlts { GpuMlt v[]; };
 #endif

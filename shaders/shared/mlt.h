@@ -24,9 +24,10 @@ SHARED_BEGIN
 #define MLT_KERNEL_MUTATE 4u   // path slot c gets chain c's proposal
 #define MLT_KERNEL_ACCEPT 5u   // splat current and proposal, accept or reject
 #define MLT_KERNEL_RESOLVE 6u  // the pass's splats into the film
-// Direct light outside the chain: path slot c gets the vector of direct sample direct.x of pixel
-// pool.x + c (a stratified camera draw in that pixel, the rest hashed), traced for direct light
-// only; then the pixel's film gets its radiance / direct.y.
+// Direct light outside the chain: pixels pool.x .. pool.x + pool.y - 1, direct.z samples each
+// (numbers direct.x + k): path slot k x pool.y + c gets the vector of sample k of pixel pool.x + c
+// (a camera draw uniform in that pixel, the rest hashed), traced for direct light only; then
+// invocation c adds its pixel's samples / direct.y to the film, in sample order (no atomics).
 #define MLT_KERNEL_DIRECT 7u
 #define MLT_KERNEL_DIRECT_ADD 8u
 #define MLT_KERNELS 9u

@@ -59,7 +59,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m.start = m_start->address;
   m.counters = m_counters->address;
   m.extent = extent->address;
-  m.direct = {0u, settings.mltDirectSpp};
+  m.direct = {0u, settings.mltDirectSpp, 0u, 0u};
   globals.host().mlt = m_mlt->address;
 
   VkCommandBuffer cmd = vk::beginOneShot(m_ctx);
@@ -202,24 +202,28 @@ void MltIntegrator::directPass(std::uint32_t sampleIndex, std::uint32_t samples)
   Globals& g = m_globals.host();
   GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
   const std::uint32_t perIteration = m_settings.mltDirectSpp;
-  // One slot per pixel in each trace (MLT_KERNEL_DIRECT_ADD adds without atomics).
-  const std::uint32_t slots = static_cast<std::uint32_t>(std::min<std::uint64_t>(m_chains, m_pixels));
+  const std::uint32_t total = samples * perIteration;
+  // Pixels per trace (at most the path slots), and as many samples of each as the slots hold.
+  const std::uint32_t pixelsPerTrace = static_cast<std::uint32_t>(std::min<std::uint64_t>(m_chains, m_pixels));
   g.radiancePart = RADIANCE_DIRECT;
   g.chunkFirst = 0;
   g.passSamples = 1;
-  for (std::uint32_t k = 0; k < samples * perIteration; ++k) {
+  for (std::uint32_t k = 0; k < total;) {
     // Direct samples are numbered by iteration, so a resumed render's continue the first segment's.
     const std::uint32_t number = sampleIndex * perIteration + k;
+    const std::uint32_t per = std::max<std::uint32_t>(1, std::min<std::uint32_t>(total - k, m_chains / pixelsPerTrace));
     g.sampleIndex = number;
     m.direct.x = number;
-    for (std::uint64_t first = 0; first < m_pixels; first += slots) {
-      const std::uint32_t count = static_cast<std::uint32_t>(std::min<std::uint64_t>(slots, m_pixels - first));
+    m.direct.z = per;
+    for (std::uint64_t first = 0; first < m_pixels; first += pixelsPerTrace) {
+      const std::uint32_t count = static_cast<std::uint32_t>(std::min<std::uint64_t>(pixelsPerTrace, m_pixels - first));
       m.pool.x = static_cast<std::uint32_t>(first);
       m.pool.y = count;
-      g.chunkPaths = count;
+      g.chunkPaths = count * per;
       m_globals.upload();
-      traceBetween(MLT_KERNEL_DIRECT, MLT_KERNEL_DIRECT_ADD, count);
+      traceBetween(MLT_KERNEL_DIRECT, MLT_KERNEL_DIRECT_ADD, count * per);
     }
+    k += per;
   }
   g.radiancePart = chainPart();
   m_globals.upload();

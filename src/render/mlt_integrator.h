@@ -84,7 +84,8 @@ class MltIntegrator : public PrimarySampleIntegrator {
   // direct light is outside the chain).
   std::uint32_t chainPart() const;
   // Direct light outside the chain: settings.mltDirectSpp x samples direct-light-only paths per
-  // pixel (stratified: one per pixel per trace), each added to the film / mltDirectSpp.
+  // pixel (each trace: as many samples of every pixel as the chains' path slots hold), each added
+  // to the film / mltDirectSpp.
   void directPass(std::uint32_t sampleIndex, std::uint32_t samples);
 
   std::uint32_t m_chains = 0, m_dims = 0, m_poolSize = 0;
