@@ -18,7 +18,10 @@
 # tools/bench_mlt.sh and tools/bench_vegas.sh call it with their integrator's default scenes.
 # Environment: SIZE (default 128), TIME (10 s), REF_SPP (2048), REPEATS (3), DEPTH (8),
 #   SCENES (default: the default Cornell box "default"), ARGS (extra options of the integrator's
-#   renders, e.g. "--mlt-chains 32768" or "--vegas-bins 16").
+#   renders, e.g. "--mlt-chains 32768" or "--vegas-bins 16"), ARGS2, ARGS3 (when set: more variants
+#   of the integrator, named INTEGRATOR-2 and INTEGRATOR-3, interleaved with the others in every
+#   repeat and each compared with the path tracer, e.g. ARGS="--mlt-direct-spp 0"
+#   ARGS2="--mlt-direct-spp 1").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 integrator=${1:?usage: tools/bench_integrator.sh mlt|vegas [DIR] [NUSSELT]}
@@ -33,6 +36,11 @@ repeats=${REPEATS:-3}
 depth=${DEPTH:-8}
 scenes=${SCENES:-default}
 mkdir -p "$dir"
+modes=(path "$integrator")
+[ -n "${ARGS2:-}" ] && modes+=("$integrator-2")
+[ -n "${ARGS3:-}" ] && modes+=("$integrator-3")
+# The options of a variant's renders.
+variantArgs() { case $1 in path) ;; *-2) echo "${ARGS2:-}" ;; *-3) echo "${ARGS3:-}" ;; *) echo "${ARGS:-}" ;; esac; }
 common="--width $size --height $size --max-depth $depth -q --checkpoint 0"
 
 # shellcheck source=tools/bench_lib.sh
@@ -40,7 +48,7 @@ source tools/bench_lib.sh
 attr() { "$bin" info "$1" | sed -n "s/^  nusselt\/$2: //p" | head -1; }
 
 echo "bench_integrator: $integrator against path, ${size}x${size}, --time $budget per run, reference $refSpp spp (path)," \
-     "max depth $depth, $repeats repeats, $integrator with: ${ARGS:-(defaults)}"
+     "max depth $depth, $repeats repeats, $integrator with: ${ARGS:-(defaults)}${ARGS2:+; $integrator-2 with: $ARGS2}${ARGS3:+; $integrator-3 with: $ARGS3}"
 echo "device: $("$bin" devices | head -1)"
 for entry in $scenes; do
   scene=${entry%%@*}
@@ -51,19 +59,18 @@ for entry in $scenes; do
   ref="$dir/$name-ref-$size-$refSpp-$depth.exr"
   # shellcheck disable=SC2086
   bench_reference "$bin" "$scene" "$ref" "$refSpp" $common
-  for mode in path "$integrator"; do : > "$dir/$name.$mode"; : > "$dir/$name.$mode.region"; done
+  for mode in "${modes[@]}"; do : > "$dir/$name.$mode"; : > "$dir/$name.$mode.region"; done
   for ((r = 1; r <= repeats; r++)); do
-    for mode in path "$integrator"; do
+    for mode in "${modes[@]}"; do
       out="$dir/$name-$mode-$r.exr"
-      extra=""
-      [ "$mode" != path ] && extra=${ARGS:-}
+      extra=$(variantArgs "$mode")
       # shellcheck disable=SC2086
-      "$bin" render $sceneArg $common --time "$budget" --seed "$r" --integrator "$mode" $extra -o "$out"
+      "$bin" render $sceneArg $common --time "$budget" --seed "$r" --integrator "${mode%-[23]}" $extra -o "$out"
       sec=$(attr "$out" renderSeconds)
       spp=$(attr "$out" spp)
       rel=$("$bin" diff "$out" "$ref" | awk '{print $2}')
       # Paths per spp: one per pixel, or one per chain for Metropolis.
-      perSpp=$(if [ "$mode" = mlt ]; then attr "$out" mltChains; else echo $((size * size)); fi)
+      perSpp=$(if [ "${mode%-[23]}" = mlt ]; then attr "$out" mltChains; else echo $((size * size)); fi)
       prod=$(calc "$rel * $sec")
       rate=$(calc "$spp * $perSpp / $sec / 1000000")
       perPath=$(calc "$rel * $spp")
@@ -78,7 +85,7 @@ for entry in $scenes; do
       fi
     done
   done
-  for mode in path "$integrator"; do
+  for mode in "${modes[@]}"; do
     rel=$(awk '{print $1}' "$dir/$name.$mode" | median)
     sec=$(awk '{print $2}' "$dir/$name.$mode" | median)
     prod=$(awk '{print $3}' "$dir/$name.$mode" | median)
@@ -88,15 +95,19 @@ for entry in $scenes; do
       "$sec" "$rate" "$prod" "$perPath"
     echo "$prod" > "$dir/$name.$mode.median"
   done
-  printf "%-14s path / %s (relMSE x s): %.3f\n" "$name" "$integrator" \
-    "$(calc "$(cat "$dir/$name.path.median") / $(cat "$dir/$name.$integrator.median")")"
+  for mode in "${modes[@]:1}"; do
+    printf "%-14s path / %s (relMSE x s): %.3f\n" "$name" "$mode" \
+      "$(calc "$(cat "$dir/$name.path.median") / $(cat "$dir/$name.$mode.median")")"
+  done
   if [ -n "$region" ]; then
-    for mode in path "$integrator"; do
+    for mode in "${modes[@]}"; do
       printf "%-14s %-5s region %s median: relMSE %.5g  relMSE x s %.5g\n" "$name" "$mode" "$region" \
         "$(awk '{print $1}' "$dir/$name.$mode.region" | median)" "$(awk '{print $2}' "$dir/$name.$mode.region" | median)"
       awk '{print $2}' "$dir/$name.$mode.region" | median > "$dir/$name.$mode.region.median"
     done
-    printf "%-14s region %s path / %s (relMSE x s): %.3f\n" "$name" "$region" "$integrator" \
-      "$(calc "$(cat "$dir/$name.path.region.median") / $(cat "$dir/$name.$integrator.region.median")")"
+    for mode in "${modes[@]:1}"; do
+      printf "%-14s region %s path / %s (relMSE x s): %.3f\n" "$name" "$region" "$mode" \
+        "$(calc "$(cat "$dir/$name.path.region.median") / $(cat "$dir/$name.$mode.region.median")")"
+    done
   fi
 done

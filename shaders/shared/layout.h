@@ -77,6 +77,15 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 #define LIGHTING_MIS 0u
 #define LIGHTING_NEE_ONLY 1u
 #define LIGHTING_BSDF_ONLY 2u
+// Which part of a path's radiance the stages add (Globals.radiancePart), by the scattering vertices
+// between the light and the camera: emission hit at shade bounce b or escaping after it has b, a
+// light sample (NEE) taken at bounce b has b + 1. Direct light has at most one (emission seen by
+// the camera ray, and NEE and MIS-weighted emitter hits from its first hit), indirect light the
+// rest. The parts use the full estimator's MIS weights, so direct + indirect = all, path by path
+// (Metropolis with direct light outside the chain: docs/mlt.md).
+#define RADIANCE_ALL 0u
+#define RADIANCE_DIRECT 1u
+#define RADIANCE_INDIRECT 2u
 
 // ---- Material flags ---------------------------------------------------------------------------------
 #define MATERIAL_EMISSIVE 1u
@@ -272,6 +281,10 @@ struct GpuMlt {
   // Kelemen's weights: (1 when on, 1 / b' (b' from paths independent of the chains' starts),
   // 1 / b, large-step probability); x = 0: plain expected-value splats.
   vec4 weights;
+  // Direct light outside the chain (RenderSettings::mltDirectSpp > 0): (the number of the first
+  // direct sample of this trace, direct samples per pixel per iteration, direct samples per pixel
+  // in this trace, 0); y = 0: direct light in the chain.
+  uvec4 direct;
   BUFREF(Vec2s) current;
   BUFREF(Vec4s) state;
   BUFREF(Uints) splats;
@@ -281,7 +294,7 @@ struct GpuMlt {
   BUFREF(Uints) extent;
   uvec2 reserved;  // std430 rounds the struct to 16 bytes
 };
-STATIC_ASSERT_SIZE(GpuMlt, 128);
+STATIC_ASSERT_SIZE(GpuMlt, 144);
 #ifndef __cplusplus
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Mlts { GpuMlt v[]; };
 #endif
@@ -384,8 +397,10 @@ struct Globals {
   uint tlasHigh;
   // The roughness bins of the scene's textured gltf_pbr materials (MATERIAL_BINNED; count 0: none).
   RoughnessBins roughnessBins;
+  uint radiancePart;     // RADIANCE_*: every contribution (the default), or only direct or indirect light
+  uint reservedG;
 };
-STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 40 * 8 + 8 + 16);
+STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 40 * 8 + 8 + 16 + 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).
 #define NUSSELT_TABULATED_BUFFERS 1
 
@@ -455,6 +470,11 @@ layout(set = 0, binding = 0, std430) readonly buffer GlobalsBlock { Globals g; }
 #define PRIMARY_BLOCK 8u
 SHARED_FN uint primarySampleIndex(uint path, uint dimension, uint dims) {
   return ((path / PRIMARY_BLOCK) * dims + dimension) * PRIMARY_BLOCK + path % PRIMARY_BLOCK;
+}
+// Whether a contribution with `scatterings` vertices between light and camera belongs to `part`
+// (RADIANCE_*).
+SHARED_FN bool radiancePartKeeps(uint part, uint scatterings) {
+  return part == RADIANCE_ALL || ((part == RADIANCE_DIRECT) == (scatterings <= 1u));
 }
 SHARED_FN uint primarySampleSlots(uint capacity) { return (capacity + PRIMARY_BLOCK - 1u) / PRIMARY_BLOCK * PRIMARY_BLOCK; }
 

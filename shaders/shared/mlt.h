@@ -24,6 +24,13 @@ SHARED_BEGIN
 #define MLT_KERNEL_MUTATE 4u   // path slot c gets chain c's proposal
 #define MLT_KERNEL_ACCEPT 5u   // splat current and proposal, accept or reject
 #define MLT_KERNEL_RESOLVE 6u  // the pass's splats into the film
+// Direct light outside the chain: pixels pool.x .. pool.x + pool.y - 1, direct.z samples each
+// (numbers direct.x + k): path slot k x pool.y + c gets the vector of sample k of pixel pool.x + c
+// (a camera draw uniform in that pixel, the rest hashed), traced for direct light only; then
+// invocation c adds its pixel's samples / direct.y to the film, in sample order (no atomics).
+#define MLT_KERNEL_DIRECT 7u
+#define MLT_KERNEL_DIRECT_ADD 8u
+#define MLT_KERNELS 9u
 // Splats are sums of fixed-point integers (2^24 units per unit of luminance-normalised radiance),
 // 64 bits per channel (two uints with carry): integer addition commutes, so the image does not
 // depend on the order in which chains splat (same seed, same image, bit for bit).
@@ -36,6 +43,7 @@ SHARED_BEGIN
 #define MLT_STREAM_MUTATE 0x6d75u
 #define MLT_STREAM_POOL 0x706fu
 #define MLT_STREAM_START 0x7374u
+#define MLT_STREAM_DIRECT 0x6469u
 
 // The chains' state: GpuMlt (layout.h, Globals.mlt).
 
@@ -49,6 +57,12 @@ SHARED_FN uvec4 mltHash(uint chain, uint iteration, uint dimension, uint seed) {
 // Bootstrap path i's vector, draw `dimension`: independent uniforms (24 bits, never 1).
 SHARED_FN vec2 mltPoolSample(uint i, uint dimension, uint seed) {
   uvec4 h = pcg4d(uvec4(i, dimension, seed, MLT_STREAM_POOL));
+  return vec2(mltUnit(h.x), mltUnit(h.y));
+}
+
+// Direct sample `number` of a pixel, draw `dimension`: independent uniforms (24 bits, never 1).
+SHARED_FN vec2 mltDirectSample(uint pixel, uint number, uint dimension, uint seed) {
+  uvec4 h = pcg4d(uvec4(pixel, number, dimension, seed ^ (MLT_STREAM_DIRECT << 16u)));
   return vec2(mltUnit(h.x), mltUnit(h.y));
 }
 

@@ -30,7 +30,7 @@ void main() {
       w = powerHeuristic(prevPdf, lightPdf);
     }
   }
-  if (w > 0.0f) {
+  if (w > 0.0f && radiancePartKeeps(g.radiancePart, pc.bounce)) {
     vec3 beta = g.pathThroughput.v[path].xyz;
     g.pathRadiance.v[path].xyz += beta * envRadiance(E, dir) * w;
   }

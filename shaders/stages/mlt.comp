@@ -101,6 +101,23 @@ void main() {
     count(m, 1u, accepted);
     count(m, 2u, live && large);
     count(m, 3u, accepted && large);
+  } else if (MLT_KERNEL == MLT_KERNEL_DIRECT) {
+    if (c >= m.pool.y * m.direct.z) return;
+    uint pixel = m.pool.x + c % m.pool.y;
+    uint number = m.direct.x + c / m.pool.y;
+    // A direct-light path reads the draws of its first two vertices (the shade stage ends it there).
+    uint extent = mltExtent(2u, dims);
+    for (uint d = 0u; d < extent; ++d) {
+      vec2 u = mltDirectSample(pixel, number, d, g.seed);
+      // Draw 0 places the ray on the image (camera.comp, IMAGE_SAMPLES): uniform within the pixel.
+      if (d == 0u) u = (vec2(float(pixel % g.width), float(pixel / g.width)) + u) / vec2(float(g.width), float(g.height));
+      primary.v[primarySampleIndex(c, d, dims)] = u;
+    }
+  } else if (MLT_KERNEL == MLT_KERNEL_DIRECT_ADD) {
+    if (c >= m.pool.y) return;
+    vec3 sum = vec3(0.0f);
+    for (uint k = 0u; k < m.direct.z; ++k) sum += tracedRadiance(k * m.pool.y + c);
+    g.film.v[m.pool.x + c].xyz += sum / float(m.direct.y);
   } else if (MLT_KERNEL == MLT_KERNEL_RESOLVE) {
     if (c >= m.info.w) return;
     vec3 sum;

@@ -609,7 +609,7 @@ void main() {
         w = powerHeuristic(prevPdf, lightPdf);
       }
     }
-    L += beta * Le * w;
+    if (radiancePartKeeps(g.radiancePart, bounce)) L += beta * Le * w;
   }
 
   // ---- Local frame: surfaces are two-sided, shade the side the ray came from ----
@@ -626,10 +626,13 @@ void main() {
     wo = toLocal(wWorld, tt, bb, ns);
   }
   vec3 xo = offsetRay(x, ng);
-  bool last = bounce >= g.maxDepth;
+  // Direct light only (RADIANCE_DIRECT): nothing after the second vertex counts, so the path ends
+  // there.
+  uint part = g.radiancePart;
+  bool last = bounce >= g.maxDepth || (part == RADIANCE_DIRECT && bounce >= 1u);
 
   ShadeMaterial m = shadeMaterial(M, x, wo, roulette, ShadeHit(S.info.x, tri, hit.y, hit.z), !frontFace);
-  if (!last && !photon && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m))
+  if (!last && !photon && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m) && radiancePartKeeps(part, bounce + 1u))
     nextEvent(m, path, key, bounce, lighting, x, xo, ng, tt, bb, ns, wo, beta);
 
   g.pathRadiance.v[path].xyz += L;

@@ -63,6 +63,7 @@ struct RenderArgs {
   float mltLargeStep = 0.3f;
   float mltSigma = 0.01f;
   std::string mltWeights = "kelemen";
+  std::uint32_t mltDirectSpp = RenderSettings{}.mltDirectSpp;
   std::uint32_t vegasBins = 64;
   std::uint32_t vegasBounces = 1;
   float vegasAlpha = 0.2f;
@@ -128,6 +129,7 @@ int renderCommand(const RenderArgs& a) {
   s.mltLargeStep = a.mltLargeStep;
   s.mltSigma = a.mltSigma;
   s.mltKelemen = a.mltWeights == "kelemen";
+  s.mltDirectSpp = a.mltDirectSpp;
   s.vegasBins = a.vegasBins;
   s.vegasBounces = a.vegasBounces;
   s.vegasAlpha = a.vegasAlpha;
@@ -843,6 +845,11 @@ int runCli(int argc, char** argv) {
                                                      "independent path samples, combined with the chain) or plain "
                                                      "(expected-value splats only; docs/mlt.md)")
       ->capture_default_str()->check(CLI::IsMember({"kelemen", "plain"}));
+  render->add_option("--mlt-direct-spp", ra.mltDirectSpp, "mlt: direct light outside the chains: path-traced "
+                                                          "direct-light samples per pixel per mutation (the chains "
+                                                          "then carry indirect light only); 0: the chains carry all "
+                                                          "light (docs/mlt.md)")
+      ->capture_default_str()->check(CLI::Range(0u, 64u));
   render->add_option("--vegas-bins", ra.vegasBins, "vegas: bins of each warped axis's density (1 .. 4096)")
       ->capture_default_str();
   render->add_option("--vegas-bounces", ra.vegasBounces, "vegas: bounces whose light choice, light point and BSDF "

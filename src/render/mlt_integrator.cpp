@@ -59,13 +59,14 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m.start = m_start->address;
   m.counters = m_counters->address;
   m.extent = extent->address;
+  m.direct = {0u, settings.mltDirectSpp, 0u, 0u};
   globals.host().mlt = m_mlt->address;
 
   VkCommandBuffer cmd = vk::beginOneShot(m_ctx);
   vkCmdFillBuffer(cmd, m_splats->buffer, 0, VK_WHOLE_SIZE, 0);
   vk::endOneShot(m_ctx, cmd);
 
-  createKernels("mlt", MLT_KERNEL_RESOLVE + 1);
+  createKernels("mlt", MLT_KERNELS);
 }
 
 MltIntegrator::~MltIntegrator() = default;
@@ -78,6 +79,7 @@ void MltIntegrator::bootstrap(std::uint32_t firstSample) {
       firstSample == 0 ? m_settings.seed
                        : shared::pcg4d(glm::uvec4(m_settings.seed, firstSample, MLT_STREAM_POOL, 0x85ebca6bu)).x;
   m.pool.w = seed;
+  g.radiancePart = chainPart();  // b and the starts are of the chains' f
   g.chunkFirst = 0;
   g.passSamples = 1;
   g.sampleIndex = 0;
@@ -171,6 +173,7 @@ void MltIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples)
   if (!m_bootstrapped) bootstrap(sampleIndex);
   Globals& g = m_globals.host();
   GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
+  g.radiancePart = chainPart();
   g.chunkFirst = 0;
   g.chunkPaths = m_chains;
   g.passSamples = 1;
@@ -188,6 +191,42 @@ void MltIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples)
   VkCommandBuffer cmd = begin();
   dispatch(cmd, MLT_KERNEL_RESOLVE, static_cast<std::uint32_t>(m_pixels));
   submit();
+  if (m_settings.mltDirectSpp) directPass(sampleIndex, samples);
+}
+
+std::uint32_t MltIntegrator::chainPart() const {
+  return m_settings.mltDirectSpp ? RADIANCE_INDIRECT : RADIANCE_ALL;
+}
+
+void MltIntegrator::directPass(std::uint32_t sampleIndex, std::uint32_t samples) {
+  Globals& g = m_globals.host();
+  GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
+  const std::uint32_t perIteration = m_settings.mltDirectSpp;
+  const std::uint32_t total = samples * perIteration;
+  // Pixels per trace (at most the path slots), and as many samples of each as the slots hold.
+  const std::uint32_t pixelsPerTrace = static_cast<std::uint32_t>(std::min<std::uint64_t>(m_chains, m_pixels));
+  g.radiancePart = RADIANCE_DIRECT;
+  g.chunkFirst = 0;
+  g.passSamples = 1;
+  for (std::uint32_t k = 0; k < total;) {
+    // Direct samples are numbered by iteration, so a resumed render's continue the first segment's.
+    const std::uint32_t number = sampleIndex * perIteration + k;
+    const std::uint32_t per = std::max<std::uint32_t>(1, std::min<std::uint32_t>(total - k, m_chains / pixelsPerTrace));
+    g.sampleIndex = number;
+    m.direct.x = number;
+    m.direct.z = per;
+    for (std::uint64_t first = 0; first < m_pixels; first += pixelsPerTrace) {
+      const std::uint32_t count = static_cast<std::uint32_t>(std::min<std::uint64_t>(pixelsPerTrace, m_pixels - first));
+      m.pool.x = static_cast<std::uint32_t>(first);
+      m.pool.y = count;
+      g.chunkPaths = count * per;
+      m_globals.upload();
+      traceBetween(MLT_KERNEL_DIRECT, MLT_KERNEL_DIRECT_ADD, count * per);
+    }
+    k += per;
+  }
+  g.radiancePart = chainPart();
+  m_globals.upload();
 }
 
 }  // namespace nusselt

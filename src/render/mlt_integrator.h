@@ -4,7 +4,8 @@
 // chain's proposed primary sample vector into a path, radiance L and pixel; the mlt stage
 // (shaders/stages/mlt.comp) mutates, accepts and splats.
 //
-//   bootstrap (once): B independent paths (vectors hashed from their index), f_i = luminance(L_i);
+//   bootstrap (once): B independent paths (vectors hashed from their index), f_i = luminance(L_i)
+//     (L: the chains' part of the radiance, below);
 //     b = mean f_i (the normalisation: the integral of f over primary sample space); each chain
 //     starts at pool path i chosen with probability f_i / sum f (on the host, from a hash of the
 //     chain index and the seed), re-traced from its vector (a path is a function of it).
@@ -17,8 +18,16 @@
 //
 // The estimate is unbiased for any chain length: the start is drawn from the pool in proportion
 // to f with b from the same pool, so E[b h(X_0)] = E[(1/B) sum_i f_i h(x_i)] = integral of f h,
-// and each step preserves it (f-invariance of the kernel). Direct light stays in the chain (the
-// whole path contribution is the chain's f): one estimator, no second pass.
+// and each step preserves it (f-invariance of the kernel).
+//
+// Direct light (RenderSettings::mltDirectSpp > 0, the default; Mitsuba's pssmlt "directSamples"):
+// the chains' f is the luminance of the indirect light only (Globals.radiancePart: light that
+// reached the camera after two or more scatterings), and every iteration also traces mltDirectSpp
+// direct-light-only paths per pixel (emission seen by the camera, NEE and MIS-weighted emitter hits
+// at its first hit; the paths end at their second vertex) whose mean goes into the film beside the
+// splats. The parts keep the full estimator's MIS weights, so their sum is the whole estimate; the
+// chains spend their mutations where Metropolis pays. 0: the whole path contribution is the
+// chains' f.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -71,6 +80,13 @@ class MltIntegrator : public PrimarySampleIntegrator {
   // kernel `after` (the pool, the chains' starts, every step).
   void traceBetween(std::uint32_t before, std::uint32_t after, std::uint32_t n);
   void readCounters();
+  // The part of a path's radiance that is the chains' f (RADIANCE_*: all, or indirect light when
+  // direct light is outside the chain).
+  std::uint32_t chainPart() const;
+  // Direct light outside the chain: settings.mltDirectSpp x samples direct-light-only paths per
+  // pixel (each trace: as many samples of every pixel as the chains' path slots hold), each added
+  // to the film / mltDirectSpp.
+  void directPass(std::uint32_t sampleIndex, std::uint32_t samples);
 
   std::uint32_t m_chains = 0, m_dims = 0, m_poolSize = 0;
   bool m_bootstrapped = false;

@@ -127,6 +127,7 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
       meta.doubles.push_back({"nusselt/mltLargeStep", r.settings.mltLargeStep});
       meta.doubles.push_back({"nusselt/mltSigma", r.settings.mltSigma});
       meta.ints.push_back({"nusselt/mltKelemen", r.settings.mltKelemen ? 1 : 0});
+      meta.ints.push_back({"nusselt/mltDirectSpp", r.settings.mltDirectSpp});
     }
     if (r.settings.integrator == IntegratorKind::Vegas) {
       meta.ints.push_back({"nusselt/vegasBins", r.settings.vegasBins});
@@ -139,7 +140,11 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
         value = (mlt ? "primary-sample-space Metropolis (PSSMLT) over the wavefront path tracer ("
                      : "VEGAS (separable warp of the first bounces' primary draws, learned per pass) over the "
                        "wavefront path tracer (") +
-                value + ")";
+                value + ")" +
+                (mlt && r.settings.mltDirectSpp
+                     ? "; direct light outside the chains, " + std::to_string(r.settings.mltDirectSpp) +
+                           " direct-only path sample(s) per pixel per mutation"
+                     : "");
   }
   if (r.source == "preview") meta.doubles.push_back({"nusselt/exposure", r.displayExposure});
   return meta;
@@ -219,6 +224,8 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
     r.settings.mltSigma = static_cast<float>(findDouble(meta, "nusselt/mltSigma").value_or(0.01));
     // Renders written before the key used the plain weights.
     r.settings.mltKelemen = findInt(meta, "nusselt/mltKelemen").value_or(0) != 0;
+    // Renders written before the key kept direct light in the chain.
+    r.settings.mltDirectSpp = static_cast<std::uint32_t>(findInt(meta, "nusselt/mltDirectSpp").value_or(0));
   }
   if (r.settings.integrator == IntegratorKind::Vegas) {
     r.settings.vegasBins = static_cast<std::uint32_t>(findInt(meta, "nusselt/vegasBins").value_or(64));
@@ -276,7 +283,11 @@ std::string firstDifference(const RenderRecord& a, const RenderRecord& b) {
         differ("the environment scale (--env-scale)", formatNumber(a.envScale), formatNumber(b.envScale)),
         differ("the environment rotation (--env-rotate)", formatNumber(a.envRotate), formatNumber(b.envRotate)),
         differ("the environment's selection (--env-select)", a.envSelect, b.envSelect),
-        differ("path guiding (--guiding)", s.guiding ? "on" : "off", t.guiding ? "on" : "off")})
+        differ("path guiding (--guiding)", s.guiding ? "on" : "off", t.guiding ? "on" : "off"),
+        // Compared when either is a Metropolis render.
+        differ("mlt's direct light outside the chain (--mlt-direct-spp)",
+               s.integrator == IntegratorKind::Mlt || t.integrator == IntegratorKind::Mlt ? std::to_string(s.mltDirectSpp) : "",
+               s.integrator == IntegratorKind::Mlt || t.integrator == IntegratorKind::Mlt ? std::to_string(t.mltDirectSpp) : "")})
     if (!d.empty()) return d;
   return {};
 }

@@ -165,6 +165,7 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   g.display = 0;
   g.seed = settings.seed;
   g.lighting = static_cast<std::uint32_t>(settings.lighting);
+  g.radiancePart = settings.radiancePart;
   g.rngMode = static_cast<std::uint32_t>(settings.rng);
   g.componentChoice = static_cast<std::uint32_t>(settings.components);
   g.roulette = static_cast<std::uint32_t>(settings.roulette);

@@ -188,6 +188,10 @@ struct RenderSettings {
   // (PathOptions::primaryDims = PathIntegrator::primaryDimsFor(maxDepth); Renderer::paths()), which
   // the caller fills: for tests of the primary sample source. Not a command-line option.
   bool primarySamples = false;
+  // The part of each path's radiance the path tracer adds (RADIANCE_*, layout.h: 0 all, 1 direct
+  // light only, 2 indirect light only; Globals.radiancePart). Not a command-line option: for tests
+  // (Metropolis sets its own, mlt_integrator.h).
+  std::uint32_t radiancePart = 0;
   // Metropolis (--integrator mlt, docs/mlt.md). Chains in flight (`--mlt-chains`; each a path slot
   // and a primary sample vector of PathIntegrator::primaryDimsFor(maxDepth) draws).
   std::uint32_t mltChains = 65536;
@@ -203,6 +207,11 @@ struct RenderSettings {
   // (each large step's path also counts as an independent path-tracer sample, both weighted by
   // 1 / (f / b' + p_large)), or the plain expected-value splats (false). docs/mlt.md.
   bool mltKelemen = true;
+  // Direct light outside the chain (`--mlt-direct-spp`, Mitsuba's directSamples): the chains' f is
+  // the indirect light only (Globals.radiancePart) and every iteration adds this many direct-light-
+  // only path-tracer samples per pixel beside the splats; 0: the whole path contribution is the
+  // chains' f (docs/mlt.md).
+  std::uint32_t mltDirectSpp = 1;
   // VEGAS (--integrator vegas, docs/vegas.md). Bins per warped axis (`--vegas-bins`, 1 .. 4096).
   std::uint32_t vegasBins = 64;
   // Bounces whose light choice, light point and BSDF draws are warped (`--vegas-bounces`, 1 ..

@@ -44,6 +44,12 @@ cp "$work/mlt.exr" "$work/resume.exr"
 if "$nusselt" render "${small[@]}" --resume "$work/resume.exr" --spp 4 2>"$work/err"; then fail "path resume of an mlt render"
 elif ! grep -qF "integrator" "$work/err"; then fail "resume message: $(cat "$work/err")"
 else echo "ok   mlt_resume_as_path: $(cat "$work/err")"; fi
+# Direct light outside the chain is recorded (the default, 1) and resuming with another value is refused.
+[ "$("$nusselt" info "$work/resume.exr" | sed -n 's/^  nusselt\/mltDirectSpp: //p')" = 1 ] || fail "mlt header: mltDirectSpp"
+if "$nusselt" render "${small[@]}" --integrator mlt --mlt-chains 1024 --mlt-direct-spp 0 --resume "$work/resume.exr" \
+  --spp 4 2>"$work/err"; then fail "mlt resume with another --mlt-direct-spp"
+elif ! grep -qF -- "--mlt-direct-spp" "$work/err"; then fail "resume message: $(cat "$work/err")"
+else echo "ok   mlt_resume_direct_spp: $(cat "$work/err")"; fi
 "$nusselt" render "${small[@]}" --integrator mlt --mlt-chains 1024 --resume "$work/resume.exr" --spp 4 \
   || fail "mlt resume"
 [ "$("$nusselt" info "$work/resume.exr" | sed -n 's/^  nusselt\/spp: //p')" = 4 ] || fail "mlt resume: spp in the header"
