@@ -270,6 +270,31 @@ TEST(Guiding, SameSeedIsBitIdenticalWithPhotons) {
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
+// The photon pre-pass's splats (100000 photons, depth 1, cosine sampler) of `scene` seen from a
+// camera at (0, 0.5, -3) looking along +z, 8 x 8, training 1 spp (the pass runs before it).
+std::vector<guiding::PhotonSplat> photonSplatsOf(Scene scene, std::uint32_t seed) {
+  scene.hasCamera = true;
+  scene.camera.position = {0.0f, 0.5f, -3.0f};
+  scene.camera.forward = {0.0f, 0.0f, 1.0f};
+  scene.camera.up = {0.0f, 1.0f, 0.0f};
+  RenderSettings s;
+  s.width = s.height = 8;
+  s.spp = 2;
+  s.maxDepth = 1;
+  s.seed = seed;
+  s.sampler = SamplerKind::Cosine;
+  s.guiding = true;
+  s.guidePhotons = 100000;
+  Renderer r(test::context(), scene, s);
+  if (!r.guide()) {
+    ADD_FAILURE() << "a guided render has no guide";
+    return {};
+  }
+  r.guide()->keepPhotonSplats(true);
+  r.render(1);
+  return r.guide()->photonSplats();
+}
+
 // Where the photon records land: a tiny Lambert light (1e-3 square, Le = 2) at height 1 facing
 // up, a Lambert ceiling (rho 0.5) at height 2 above it and a floor at 0 (both 200 wide, so
 // that under 1e-3 escapes, and the rays' offset, 1/65536 of the scene's radius, is 2e-3 of the
@@ -301,23 +326,7 @@ TEST(Guiding, PhotonRecordsLandWhereLightArrivesIndirectly) {
   test::addQuad(scene, {-W, 0, -W}, {-W, 0, W}, {W, 0, W}, {W, 0, -W}, white);  // floor, normal +y
   test::addQuad(scene, {-W, 2, -W}, {W, 2, -W}, {W, 2, W}, {-W, 2, W}, white);  // ceiling, normal -y
   test::addQuad(scene, {-h, 1, -h}, {-h, 1, h}, {h, 1, h}, {h, 1, -h}, lamp);   // light, normal +y
-  scene.hasCamera = true;
-  scene.camera.position = {0.0f, 0.5f, -3.0f};
-  scene.camera.forward = {0.0f, 0.0f, 1.0f};
-  scene.camera.up = {0.0f, 1.0f, 0.0f};
-  RenderSettings s;
-  s.width = s.height = 8;
-  s.spp = 2;  // training 1 spp: the photon pass runs before it
-  s.maxDepth = 1;
-  s.seed = 9;
-  s.sampler = SamplerKind::Cosine;
-  s.guiding = true;
-  s.guidePhotons = 100000;
-  Renderer r(test::context(), scene, s);
-  ASSERT_NE(r.guide(), nullptr);
-  r.guide()->keepPhotonSplats(true);
-  r.render(1);
-  const std::vector<guiding::PhotonSplat>& splats = r.guide()->photonSplats();
+  const std::vector<guiding::PhotonSplat> splats = photonSplatsOf(scene, 9);
   const std::uint32_t n = static_cast<std::uint32_t>(splats.size());
   ASSERT_GT(n, 90000u) << "nearly every photon must arrive on the floor after its bounce";
   constexpr int kBins = 20;
@@ -381,23 +390,7 @@ TEST(Guiding, PhotonRecordsFromAPointLight) {
   point.position = {0.0f, 1.0f, 0.0f};
   point.intensity = glm::vec3(1.0f);
   scene.lights.push_back(point);
-  scene.hasCamera = true;
-  scene.camera.position = {0.0f, 0.5f, -3.0f};
-  scene.camera.forward = {0.0f, 0.0f, 1.0f};
-  scene.camera.up = {0.0f, 1.0f, 0.0f};
-  RenderSettings s;
-  s.width = s.height = 8;
-  s.spp = 2;
-  s.maxDepth = 1;
-  s.seed = 10;
-  s.sampler = SamplerKind::Cosine;
-  s.guiding = true;
-  s.guidePhotons = 100000;
-  Renderer r(test::context(), scene, s);
-  ASSERT_NE(r.guide(), nullptr);
-  r.guide()->keepPhotonSplats(true);
-  r.render(1);
-  const std::vector<guiding::PhotonSplat>& splats = r.guide()->photonSplats();
+  const std::vector<guiding::PhotonSplat> splats = photonSplatsOf(scene, 10);
   const std::uint32_t n = static_cast<std::uint32_t>(splats.size());
   ASSERT_GT(n, 90000u) << "nearly every photon must arrive on the floor or the ceiling after its bounce";
   constexpr int kBins = 20;

@@ -720,6 +720,18 @@ TEST(TexturesRender, TintedGlassSlabFromGltfTransmitsFresnelTimesAttenuationColo
   expectImageMeanRgb(test::render(s, rs), expected);
 }
 
+// The mean of channel k over the left (half 0) or right (half 1) 8 x 16 pixels of a 16 x 16
+// image, and its standard error from the per-pixel variances of the mean.
+std::pair<double, double> halfMean(const Image& image, int half, int k) {
+  double sum = 0, var = 0;
+  for (int py = 0; py < 16; ++py)
+    for (int px = 8 * half; px < 8 * half + 8; ++px) {
+      sum += image.rgb[3 * (py * 16 + px) + k];
+      var += image.variance[3 * (py * 16 + px) + k];
+    }
+  return {sum / 128, std::sqrt(var) / 128};
+}
+
 // KHR_materials_transmission's texture (transmissionTextured): a thin-walled sheet (the glTF
 // combination {gltf_pbr white, 1 - w; thin_dielectric eta 1.5, w}, w = 1) at z = 0.3 with a 2 x 1
 // NEAREST transmission texture, R = 255 over x < 0 and 64 over x > 0, over an emitter of
@@ -753,13 +765,7 @@ TEST(TexturesRender, TransmissionTextureScalesTheTransmittedLight) {
   for (int half = 0; half < 2; ++half) {
     const double expected = (half == 0 ? 1.0 : 64.0 / 255.0) * T;
     for (int k = 0; k < 3; ++k) {
-      double sum = 0, var = 0;
-      for (int py = 0; py < 16; ++py)
-        for (int px = 8 * half; px < 8 * half + 8; ++px) {
-          sum += r.image.rgb[3 * (py * 16 + px) + k];
-          var += r.image.variance[3 * (py * 16 + px) + k];
-        }
-      const double mean = sum / 128, se = std::sqrt(var) / 128;
+      const auto [mean, se] = halfMean(r.image, half, k);
       EXPECT_LT(std::fabs(mean - expected) / se, zMax)
           << "half " << half << " channel " << k << ": " << mean << " vs " << expected << " (se " << se << ")";
       if (half == 1) EXPECT_GT(std::fabs(mean - T) / se, 10.0);
@@ -816,13 +822,7 @@ TEST(TexturesRender, BaseColorTextureTintsTheTransmittedLight) {
       double farthest = 0;
       for (int k = 0; k < 3; ++k) {
         const double expected = srgb(codes[half][k]) * T;
-        double sum = 0, var = 0;
-        for (int py = 0; py < 16; ++py)
-          for (int px = 8 * half; px < 8 * half + 8; ++px) {
-            sum += r.image.rgb[3 * (py * 16 + px) + k];
-            var += r.image.variance[3 * (py * 16 + px) + k];
-          }
-        const double mean = sum / 128, se = std::sqrt(var) / 128;
+        const auto [mean, se] = halfMean(r.image, half, k);
         EXPECT_LT(std::fabs(mean - expected) / se, zMax)
             << "half " << half << " channel " << k << ": " << mean << " vs " << expected << " (se " << se << ")";
         farthest = std::max(farthest, std::fabs(mean - T) / se);

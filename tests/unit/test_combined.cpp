@@ -154,7 +154,16 @@ TEST(CombinedChoice, ComponentAlbedoEstimates) {
   c.params.v[1] = vec4(6.69f, 6.69f, 0.0f, 0.0f);    // k.y, k.z
   EXPECT_FLOAT_EQ(componentChoiceAlbedo(SAMPLER_COSINE, MODEL_MIRROR, c, wo),
                   0.5f * luminance(mirrorReflectance(c.params, wo.z)));
-  EXPECT_FLOAT_EQ(componentChoiceAlbedo(SAMPLER_COSINE, MODEL_DIELECTRIC, c, wo), 0.5f);
+  // A clear dielectric (tint 1) is lossless: exactly its weight; a tinted one reflects R and
+  // transmits (1 - R) x the tint's luminance.
+  GpuComponent d = c;
+  d.params = BrdfParams{};
+  d.params.v[0] = vec4(1.5f, 1.0f, 1.0f, 1.0f);  // eta, tint rgb
+  EXPECT_EQ(componentChoiceAlbedo(SAMPLER_COSINE, MODEL_DIELECTRIC, d, wo), 0.5f);
+  d.params.v[0] = vec4(1.5f, 0.8f, 0.5f, 0.2f);
+  const float R = fresnelDielectric(wo.z, 1.5f);
+  EXPECT_FLOAT_EQ(componentChoiceAlbedo(SAMPLER_COSINE, MODEL_DIELECTRIC, d, wo),
+                  0.5f * (R + (1.0f - R) * luminance(vec3(0.8f, 0.5f, 0.2f))));
   // A tabulated (non-quadtree) component: linear in cos theta between the nodes i / 7.
   c.info.x = MODEL_LAMBERT;
   c.albedoLo = vec4(0.0f, 0.1f, 0.2f, 0.3f);
