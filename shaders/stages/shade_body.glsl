@@ -90,10 +90,7 @@ void texturedParams(uint model, vec3 base, vec2 mr, inout BrdfParams params) {
     params.v[GLTF_PBR_METALLIC / 4u][GLTF_PBR_METALLIC % 4u] *= mr.x;
     params.v[GLTF_PBR_ROUGHNESS / 4u][GLTF_PBR_ROUGHNESS % 4u] *= mr.y;
   }
-  uint tint = model == MODEL_DIELECTRIC        ? DIELECTRIC_TINT
-              : model == MODEL_THIN_DIELECTRIC  ? THIN_DIELECTRIC_TINT
-              : model == MODEL_ROUGH_DIELECTRIC ? ROUGH_DIELECTRIC_TINT
-                                                : INVALID_INDEX;
+  uint tint = modelTintParam(model);
   if (tint != INVALID_INDEX)
     for (uint k = 0u; k < 3u; ++k) params.v[(tint + k) / 4u][(tint + k) % 4u] *= base[k];
 }

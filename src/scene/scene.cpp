@@ -80,9 +80,7 @@ bool Material::hasGltfPbr() const {
 }
 
 bool Material::hasTintedTransmission() const {
-  return anyModel(*this, [](std::uint32_t id) {
-    return id == MODEL_DIELECTRIC || id == MODEL_THIN_DIELECTRIC || id == MODEL_ROUGH_DIELECTRIC;
-  });
+  return anyModel(*this, [](std::uint32_t id) { return shared::modelTintParam(id) != INVALID_INDEX; });
 }
 
 void setComponents(Material& m, const std::vector<MaterialComponent>& components) {

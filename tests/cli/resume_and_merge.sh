@@ -10,6 +10,16 @@ fails=0
 fail() { echo "FAIL $*"; fails=$((fails + 1)); }
 common=(--width 24 --height 16 --seed 3 --max-depth 4 -q)
 maxdiff() { "$nusselt" diff "$1" "$2" | sed -n 's/.*max |diff| //p'; }
+# expect_refused WHAT PATTERN COMMAND...: the command must fail with PATTERN in its error output.
+expect_refused() {
+  local what=$1 pattern=$2
+  shift 2
+  if "$@" 2>"$work/err"; then
+    fail "$what accepted"
+  else
+    grep -q -- "$pattern" "$work/err" && echo "ok   $what refused: $(cat "$work/err")" || fail "$what refusal: $(cat "$work/err")"
+  fi
+}
 
 "$nusselt" render "${common[@]}" --spp 6 -o "$work/full.exr" || fail "full render"
 
@@ -65,12 +75,8 @@ for k in 3 5 9; do
 done
 # Its guide settings must be the saved render's.
 "$nusselt" render "${common[@]}" "${guided[@]}" --spp 3 -o "$work/g3.exr" || fail "guided render of 3 spp"
-if "$nusselt" render "${common[@]}" --guiding on --guide-train 7 --guide-alpha 0.25 --spp 12 --resume "$work/g3.exr" 2>"$work/err"; then
-  fail "guided resume with another --guide-alpha accepted"
-else
-  grep -q -- "--guide-alpha was 0.5" "$work/err" && echo "ok   guided resume with another --guide-alpha refused: $(cat "$work/err")" ||
-    fail "guided resume refusal: $(cat "$work/err")"
-fi
+expect_refused "guided resume with another --guide-alpha" "--guide-alpha was 0.5" \
+  "$nusselt" render "${common[@]}" --guiding on --guide-train 7 --guide-alpha 0.25 --spp 12 --resume "$work/g3.exr"
 
 # With the photon pre-pass (--guide-photons): the resumed run traces the same photons again before
 # its retraining; a resume with another photon count is refused.
@@ -84,12 +90,8 @@ grep -q "warning" "$work/err" && fail "resume with photons warns: $(grep warning
 [ "$(maxdiff "$work/p5.exr" "$work/pfull.exr")" = 0 ] && echo "ok   guided with photons, resumed 5 -> 12 spp equals 12 spp bit for bit" ||
   fail "resume with photons differs: $("$nusselt" diff "$work/p5.exr" "$work/pfull.exr")"
 "$nusselt" render "${common[@]}" "${photons[@]}" --spp 3 -o "$work/p3.exr" || fail "render with photons of 3 spp"
-if "$nusselt" render "${common[@]}" --guiding on --guide-train 7 --guide-alpha 0.5 --spp 12 --resume "$work/p3.exr" 2>"$work/err"; then
-  fail "resume without the saved render's photons accepted"
-else
-  grep -q -- "--guide-photons was 3000" "$work/err" && echo "ok   resume with another --guide-photons refused: $(cat "$work/err")" ||
-    fail "photon resume refusal: $(cat "$work/err")"
-fi
+expect_refused "resume with another --guide-photons" "--guide-photons was 3000" \
+  "$nusselt" render "${common[@]}" --guiding on --guide-train 7 --guide-alpha 0.5 --spp 12 --resume "$work/p3.exr"
 
 # Split across two jobs by --spp-offset, merged: the single 6-spp render up to float rounding
 # of the sums (the parts add their sums in another order).

@@ -103,8 +103,8 @@ TEST(Guiding, UnbiasedUnderAnEnvironment) {
   expectUnbiased(scene, 32, 64, 4, 4);
 }
 
-TEST(Guiding, SameSeedIsBitIdentical) {
-  Scene scene = test::loadTestScene("scenes/cornell/cornell-indirect.glb");
+// The determinism tests' guided render of cornell-indirect: 24 x 20, 16 spp, depth 5, seed 3.
+RenderSettings determinismSettings() {
   RenderSettings s;
   s.width = 24;
   s.height = 20;
@@ -112,6 +112,12 @@ TEST(Guiding, SameSeedIsBitIdentical) {
   s.maxDepth = 5;
   s.seed = 3;
   s.guiding = true;
+  return s;
+}
+
+TEST(Guiding, SameSeedIsBitIdentical) {
+  Scene scene = test::loadTestScene("scenes/cornell/cornell-indirect.glb");
+  RenderSettings s = determinismSettings();
   // The learned alpha (auto, the default) and a fixed one; the fixed one also with the spatial
   // splat filter and a floor (the default splats are box-filtered in direction).
   for (float alpha : {-1.0f, 0.5f, 0.25f}) {
@@ -249,13 +255,7 @@ TEST(Guiding, UnbiasedWithPhotonPrePass) {
 // guide: alpha fixed at 0.5).
 TEST(Guiding, SameSeedIsBitIdenticalWithPhotons) {
   Scene scene = test::loadTestScene("scenes/cornell/cornell-indirect.glb");
-  RenderSettings s;
-  s.width = 24;
-  s.height = 20;
-  s.spp = 16;
-  s.maxDepth = 5;
-  s.seed = 3;
-  s.guiding = true;
+  RenderSettings s = determinismSettings();
   s.guideAlpha = 0.5f;
   s.guidePhotons = 5000;
   s.maxPathsPerChunk = 2048;  // the photons in three chunks

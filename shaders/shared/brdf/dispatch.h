@@ -27,6 +27,15 @@ SHARED_FN bool modelIsDelta(uint model) {
 // parameters differ with the side the path is on (transmissionInsideParams).
 SHARED_FN bool modelTransmits(uint model) { return ROUGH_DIELECTRIC_TRANSMITS != 0 && model == MODEL_ROUGH_DIELECTRIC; }
 
+// The offset of a model's `tint` parameter (the colour of the light it transmits at each crossing:
+// glTF's base colour on KHR_materials_transmission), or INVALID_INDEX for a model without one.
+SHARED_FN uint modelTintParam(uint model) {
+  if (model == MODEL_DIELECTRIC) return DIELECTRIC_TINT;
+  if (model == MODEL_THIN_DIELECTRIC) return THIN_DIELECTRIC_TINT;
+  if (model == MODEL_ROUGH_DIELECTRIC) return ROUGH_DIELECTRIC_TINT;
+  return INVALID_INDEX;
+}
+
 // The parameters of a transmitting model seen from the inside (the -z side of its frame) in the
 // frame turned over (inside = +z), so that f(wi, wo; p) = f(flipZ(wi), flipZ(wo); inside(p)); p for
 // every other model.
