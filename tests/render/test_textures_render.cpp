@@ -309,20 +309,9 @@ TEST(TexturesRender, EmittersWithAlphaAgreeUnderNeeBsdfAndMis) {
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
-// The directional albedo at normal incidence of gltf_pbr(base, metal, rough), the integral of
-// f cos over the hemisphere, by a stratified 1024 x 1024 cosine-weighted quadrature of the same
-// BRDF (shared C++ build).
+// The directional albedo at normal incidence of gltf_pbr(base, metal, rough).
 glm::dvec3 gltfPbrAlbedoAtNormalIncidence(glm::vec3 base, float metal, float rough) {
-  Material p = gltfPbr(base, metal, rough);
-  const int n = 1024;
-  glm::dvec3 a(0.0);
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      glm::vec3 wi = shared::squareToCosineHemisphere(glm::vec2((i + 0.5f) / n, (j + 0.5f) / n));
-      glm::vec3 f = shared::brdfEval(MODEL_GLTF_PBR, p.params, wi, glm::vec3(0, 0, 1));
-      for (int k = 0; k < 3; ++k) a[k] += f[k] * M_PI;  // f cos / pdf, pdf = cos / pi
-    }
-  return a / (double(n) * n);
+  return test::albedoAtNormalIncidence(MODEL_GLTF_PBR, gltfPbr(base, metal, rough).params);
 }
 
 // A quad of material `m` (its textures' images already in s) under a uniform white sky (radiance

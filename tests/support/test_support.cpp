@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "../../shaders/shared/brdf/dispatch.h"
+#include "../../shaders/shared/warp.h"
 #include "cli/cli_common.h"
 #include "scene/gltf_loader.h"
 #include "util/error.h"
@@ -250,6 +251,17 @@ void runKernel(const std::string& name, const std::vector<std::uint32_t>& specia
 }
 
 double normalPValue(double z) { return std::erfc(std::fabs(z) / std::sqrt(2.0)); }
+
+glm::dvec3 albedoAtNormalIncidence(std::uint32_t model, const shared::BrdfParams& p, int n) {
+  glm::dvec3 a(0.0);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      glm::vec3 wi = shared::squareToCosineHemisphere(glm::vec2((i + 0.5f) / n, (j + 0.5f) / n));
+      glm::vec3 f = shared::brdfEval(model, p, wi, glm::vec3(0, 0, 1));
+      for (int k = 0; k < 3; ++k) a[k] += f[k] * M_PI;  // f cos / pdf, pdf = cos / pi
+    }
+  return a / (double(n) * n);
+}
 
 double normalQuantileUpper(double p) {
   // Bisection on the upper tail: plenty accurate for test thresholds.

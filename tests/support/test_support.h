@@ -109,6 +109,10 @@ struct RoughSplit {
 RoughSplit roughDielectricSplit(float alpha, float eta, glm::vec3 wo, int N,
                                 const std::function<bool(glm::vec3)>& accept = {});
 
+// The directional albedo at normal incidence of `model` with params p, the integral of f cos over
+// the hemisphere, by a stratified n x n cosine-weighted quadrature of the shared C++ BRDF.
+glm::dvec3 albedoAtNormalIncidence(std::uint32_t model, const shared::BrdfParams& p, int n = 1024);
+
 // Two-sided p-value of a standard normal z.
 double normalPValue(double z);
 // Inverse of the upper tail of the standard normal: z with P(Z > z) = p.
