@@ -6,9 +6,14 @@
 # `nusselt diff`). Prints per run and the medians: relMSE, seconds, relMSE x seconds (lower is
 # better: the error at equal time, for an error falling as 1 / time), and per variant the ratio
 # unguided / guided of the medians' products (> 1: guiding wins).
+# With TIME=T the runs are at equal time instead: `render --time T --spp SPP` (SPP the cap, then
+# set it high), each stopping at its first pass boundary after T seconds of rendering (the guide's
+# training passes count; set-up and pipelines do not); the runs also print the spp they reached,
+# and the ratio compares the relMSEs themselves (and, for the record, relMSE x seconds).
 #
 #   tools/bench_guiding.sh [DIR] [NUSSELT]
-# Environment: SIZE (default 128), SPP (64), REF_SPP (4096), REPEATS (3), DEPTH (8),
+# Environment: SIZE (default 128), SPP (64), REF_SPP (4096), REPEATS (3), DEPTH (8), TIME (unset:
+#   equal spp; a number of seconds: equal render time, SPP the cap),
 #   SCENES (default: scenes/cornell/cornell-indirect.glb, scenes/tests/guiding_gap.gltf and the
 #   default Cornell box, "default"),
 #   GUIDE_ARGS (extra options of the guided renders, e.g. "--guide-spatial 1000"),
@@ -29,13 +34,18 @@ mkdir -p "$dir"
 # shellcheck source=tools/bench_lib.sh
 source tools/bench_lib.sh
 common="--width $size --height $size --max-depth $depth -q --checkpoint 0"
+budget=${TIME:-}
+if [ -n "$budget" ]; then
+  awk -v t="$budget" 'BEGIN { exit !(t > 0) }' || { echo "TIME=$budget is not a positive number of seconds" >&2; exit 2; }
+fi
 
 
 IFS='|' read -r -a variants <<< "${VARIANTS:-}"
 [ ${#variants[@]} -eq 0 ] && variants=("")
 modes=(off)
 for ((v = 0; v < ${#variants[@]}; v++)); do modes+=("on$v"); done
-echo "bench_guiding: ${size}x${size}, $spp spp per run, reference $refSpp spp (unguided), max depth $depth, $repeats repeats, guided with: --guiding on ${GUIDE_ARGS:-}"
+if [ -n "$budget" ]; then per="$budget s of rendering per run (at most $spp spp)"; else per="$spp spp per run"; fi
+echo "bench_guiding: ${size}x${size}, $per, reference $refSpp spp (unguided), max depth $depth, $repeats repeats, guided with: --guiding on ${GUIDE_ARGS:-}"
 for ((v = 0; v < ${#variants[@]}; v++)); do echo "  variant on$v: ${variants[$v]}"; done
 echo "load average at the start: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "device: $("$bin" devices | head -1)"
@@ -46,6 +56,15 @@ for scene in $scenes; do
   # shellcheck disable=SC2086
   bench_reference "$bin" "$scene" "$ref" "$refSpp" $common
   for mode in "${modes[@]}"; do : > "$dir/$name.$mode"; done
+  # One untimed render per mode first: lavapipe compiles a pipeline at its first dispatch (Mesa's
+  # disk cache keeps it for later processes), which would otherwise land in the first round's
+  # time, and with TIME in its budget (a cold cache once left a guided run 1 spp).
+  for mode in "${modes[@]}"; do
+    extra="--guiding off"
+    [ "$mode" != off ] && extra="--guiding on ${GUIDE_ARGS:-} ${variants[${mode#on}]}"
+    # shellcheck disable=SC2086
+    "$bin" render $sceneArg $common --width 16 --height 16 --spp 2 --guide-train 1 $extra -o "$dir/warm-up.exr"
+  done
   for ((r = 1; r <= repeats; r++)); do
     for mode in "${modes[@]}"; do
       out="$dir/$name-$mode-$r.exr"
@@ -57,21 +76,23 @@ for scene in $scenes; do
         extra="${GUIDE_ARGS:-} ${variants[${mode#on}]}"
       fi
       # shellcheck disable=SC2086
-      "$bin" render $sceneArg $common --spp "$spp" --seed "$r" --guiding "$guiding" $extra -o "$out"
+      "$bin" render $sceneArg $common --spp "$spp" ${budget:+--time "$budget"} --seed "$r" --guiding "$guiding" $extra -o "$out"
       t1=$(date +%s.%N)
       sec=$(echo "$t1 - $t0" | bc -l)
       rel=$("$bin" diff "$out" "$ref" | awk '{print $2}')
       prod=$(calc "$rel * $sec")
-      printf "%-20s guiding %-3s seed %d: relMSE %.5g  %.2f s  relMSE x s %.5g  (load %s)\n" "$name" "$mode" "$r" "$rel" \
-        "$sec" "$prod" "$(cut -d' ' -f1 /proc/loadavg)"
-      echo "$rel $sec $prod" >> "$dir/$name.$mode"
+      got=$("$bin" info "$out" | awk '$1 == "nusselt/spp:" {print $2}')
+      printf "%-20s guiding %-3s seed %d: relMSE %.5g  %.2f s  relMSE x s %.5g  %s spp  (load %s)\n" "$name" "$mode" "$r" \
+        "$rel" "$sec" "$prod" "$got" "$(cut -d' ' -f1 /proc/loadavg)"
+      echo "$rel $sec $prod $got" >> "$dir/$name.$mode"
     done
   done
   for mode in "${modes[@]}"; do
     mr=$(awk '{print $1}' "$dir/$name.$mode" | median)
     ms=$(awk '{print $2}' "$dir/$name.$mode" | median)
     mp=$(awk '{print $3}' "$dir/$name.$mode" | median)
-    printf "%-20s guiding %-3s median: relMSE %.5g  %.2f s  relMSE x s %.5g\n" "$name" "$mode" "$mr" "$ms" "$mp"
+    mg=$(awk '{print $4}' "$dir/$name.$mode" | median)
+    printf "%-20s guiding %-3s median: relMSE %.5g  %.2f s  relMSE x s %.5g  %s spp\n" "$name" "$mode" "$mr" "$ms" "$mp" "$mg"
     eval "p_$mode=$mp"
     eval "r_$mode=$mr"
   done
