@@ -320,8 +320,12 @@ int renderCommand(const RenderArgs& a) {
                      (r.photons ? "photons " + std::to_string(r.iteration) : std::to_string(r.iteration)).c_str(), static_cast<unsigned long long>(r.splats), r.leaves,
                      static_cast<unsigned long long>(r.dirNodes), r.bytes / 1048576.0, s.guideMemory / 1048576.0,
                      r.dirThreshold, r.capped ? ", memory cap reached" : "", r.guidedLeaves, r.meanAlpha);
-      std::fprintf(stderr, "guiding: %u training spp, %.3f s of CPU time reading records, splatting and refining\n",
-                   renderer.summary().guideTrainSpp, guide->trainingSeconds());
+      // A render that stopped (--time, an interrupt) before the end of training says so.
+      const std::uint32_t planned = renderer.summary().guideTrainSpp;
+      const std::uint32_t trained = std::min<std::uint64_t>(planned, rec.spp);
+      std::fprintf(stderr, "guiding: %u training spp%s, %.3f s of CPU time reading records, splatting and refining\n",
+                   trained, trained < planned ? (" of " + std::to_string(planned) + " (stopped during training)").c_str() : "",
+                   guide->trainingSeconds());
     }
     if (const MltIntegrator* mlt = renderer.mlt(); mlt && !a.quiet) {
       const MltReport& m = mlt->report();
