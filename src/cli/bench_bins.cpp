@@ -22,6 +22,7 @@
 #include "../../shaders/shared/bsdf_sampling.h"
 #include "brdf/albedo.h"
 #include "cli/commands.h"
+#include "quadtree/roughness_bins.h"
 #include "quadtree/sampler_tables.h"
 
 namespace nusselt {
@@ -85,12 +86,6 @@ quadtree::QuadtreeSettings partialSettings(const BinsArgs& a) {
   return qs;
 }
 
-std::vector<std::pair<std::uint32_t, BrdfParams>> binList(RoughnessBins B) {
-  std::vector<std::pair<std::uint32_t, BrdfParams>> m;
-  for (std::uint32_t j = 0; j < B.count; ++j) m.push_back({MODEL_GLTF_PBR, binParams(binRoughness(B, j))});
-  return m;
-}
-
 int benchBins(const BinsArgs& a) {
   for (double th : a.thetas)
     if (std::fabs(th / (90.0 / a.thetaTables) - std::round(th / (90.0 / a.thetaTables))) > 1e-9)
@@ -106,8 +101,7 @@ int benchBins(const BinsArgs& a) {
     for (std::uint32_t k : a.bins) {
       Config c;
       c.B = RoughnessBins{0u, k, s, 0u};
-      std::vector<std::uint32_t> idx;
-      c.t = quadtree::buildSamplerTables(binList(c.B), qs, idx);
+      c.t = quadtree::buildRoughnessBinTables(c.B, qs);
       configs.push_back(std::move(c));
     }
 
@@ -176,8 +170,7 @@ int benchBins(const BinsArgs& a) {
     fs.threads = a.threads;
     for (float s : a.spacings)
       for (std::uint32_t k : a.bins) {
-        std::vector<std::uint32_t> idx;
-        quadtree::SamplerTables t = quadtree::buildSamplerTables(binList(RoughnessBins{0u, k, s, 0u}), fs, idx);
+        quadtree::SamplerTables t = quadtree::buildRoughnessBinTables(RoughnessBins{0u, k, s, 0u}, fs);
         double cpu = 0;
         for (const quadtree::MaterialStats& st : t.materials) cpu += st.buildSeconds;
         std::printf("| %u | %g | %llu | %.2f | %.1f | %.1f |\n", k, s, static_cast<unsigned long long>(t.bytes()),

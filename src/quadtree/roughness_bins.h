@@ -1,0 +1,21 @@
+// roughness_bins.h: the roughness bins of binned sampling (shaders/shared/bsdf_sampling.h, "Binned
+// sampling"; issue 18): the materials whose trees they are, for the render's table build
+// (src/render/material_table.cpp), `nusselt sample --roughness-bins`, `nusselt bench bins` and the tests.
+#pragma once
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "../../shaders/shared/bsdf_sampling.h"
+#include "quadtree/sampler_tables.h"
+
+namespace nusselt::quadtree {
+
+// The bins' materials in order: gltf_pbr's pure specular lobe (binParams) at binRoughness(B, j),
+// j = 0 .. B.count - 1. Built first in a buildSamplerTables list, they are sets 0 .. B.count - 1.
+std::vector<std::pair<std::uint32_t, shared::BrdfParams>> roughnessBinMaterials(shared::RoughnessBins B);
+
+// The bins alone (B.first must be 0): their tables built with `settings`.
+SamplerTables buildRoughnessBinTables(shared::RoughnessBins B, const QuadtreeSettings& settings);
+
+}  // namespace nusselt::quadtree
