@@ -15,7 +15,15 @@ namespace nusselt::quadtree {
 // j = 0 .. B.count - 1. Built first in a buildSamplerTables list, they are sets 0 .. B.count - 1.
 std::vector<std::pair<std::uint32_t, shared::BrdfParams>> roughnessBinMaterials(shared::RoughnessBins B);
 
-// The bins alone (B.first must be 0): their tables built with `settings`.
+// Writes the Fresnel moments of every table of the bins' sets B.first .. into QuadTable.info.w
+// (bsdf_sampling.h, binFresnelMoments, which binnedDiffuseChoice reads): A5, the albedo of bin j's
+// lobe at the table's direction weighted by (1 - v.h)^5, by a quadrature over GGX's distribution
+// of half vectors (64 x 64 points, which follow the lobe whatever its width, the near-mirror r = 0 bin included),
+// and B5 = (1 / pi) * integral of (1 - v.h)^5 cos theta_i, by a quadrature over the cosine. Every
+// table, built or not (onlyThetaTables), from its direction on the grid.
+void setRoughnessBinMoments(SamplerTables& tables, shared::RoughnessBins B);
+
+// The bins alone (B.first must be 0): their tables built with `settings`, with their moments.
 SamplerTables buildRoughnessBinTables(shared::RoughnessBins B, const QuadtreeSettings& settings);
 
 }  // namespace nusselt::quadtree

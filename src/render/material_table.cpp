@@ -189,6 +189,7 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
   if (anyBinned) {
     for (std::uint32_t j = 0; j < m_bins.count; ++j)
       if (setOf[j] != j) throw Error("internal: the roughness bins are not the first quadtree sets");
+    quadtree::setRoughnessBinMoments(qt, m_bins);
     m_plan.roughnessBins = m_bins.count;
     for (const quadtree::MaterialStats& st : qt.materials)
       if (st.set < m_bins.count) m_plan.binBytes += st.bytes;

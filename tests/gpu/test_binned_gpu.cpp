@@ -39,10 +39,7 @@ using namespace nusselt::shared;
 TEST(BinnedGpu, ChiSquareAgainstTheCpuPdf) {
   vk::Context& ctx = test::context();
   const RoughnessBins B{0u, 4u, 1.0f, 0u};
-  std::vector<std::pair<std::uint32_t, BrdfParams>> list;
-  for (std::uint32_t j = 0; j < B.count; ++j) list.push_back({MODEL_GLTF_PBR, binParams(binRoughness(B, j))});
-  std::vector<std::uint32_t> idx;
-  const quadtree::SamplerTables t = quadtree::buildSamplerTables(list, qttest::testSettings(), idx);
+  const quadtree::SamplerTables t = quadtree::buildRoughnessBinTables(B, qttest::testSettings());
   struct C {
     vec3 base;
     float metallic, roughness;
