@@ -162,7 +162,7 @@ int benchBins(const BinsArgs& a) {
 
   if (a.full) {
     std::printf("\nmemory and build time of the bins with all %u theta tables (cache off; CPU seconds summed over the "
-                "trees; moments: the Fresnel moments of every table, setRoughnessBinMoments, one thread)\n\n"
+                "trees; moments: the Fresnel moments of every table, setRoughnessBinMoments, on every core)\n\n"
                 "| K | spacing | bytes | MiB | build CPU s | build wall s | moments wall s |\n|---|---|---|---|---|---|---|\n",
                 a.thetaTables);
     quadtree::QuadtreeSettings fs;

@@ -2,7 +2,9 @@
 #include "quadtree/roughness_bins.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <thread>
 
 #include "util/error.h"
 
@@ -61,20 +63,35 @@ std::uint32_t unorm16(double x) { return std::uint32_t(std::lround(std::clamp(x,
 }  // namespace
 
 void setRoughnessBinMoments(SamplerTables& tables, RoughnessBins B) {
-  std::vector<double> b5;  // B5 per theta table (the same for every bin of the same grid)
   for (std::uint32_t j = 0; j < B.count; ++j) {
     const QuadSet& S = tables.sets.at(B.first + j);
     if ((S.info.w & (QT_SET_ANISOTROPIC | QT_SET_TRANSMITS)) != 0u)
       throw Error("internal: a roughness bin's set is not that of an isotropic reflecting lobe");
-    const float r = binRoughness(B, j);
-    for (std::uint32_t k = 0; k < S.info.y; ++k) {
-      const double theta = double(k) * S.data.y;
-      const vec3 wo(float(std::sin(theta)), 0.0f, float(std::cos(theta)));
-      if (b5.size() <= k) b5.push_back(fresnelCosineMoment(wo));
-      const std::uint32_t packed = unorm16(fresnelLobeAlbedo(r, wo)) | (unorm16(b5[k]) << 16);
-      for (std::uint32_t i = 0; i < S.info.z; ++i) tables.tables.at(S.info.x + k * S.info.z + i).info.w = packed;
-    }
+    if (S.info.y != tables.sets.at(B.first).info.y || S.data.y != tables.sets.at(B.first).data.y)
+      throw Error("internal: the roughness bins' sets have different theta grids");
+    for (std::uint32_t k = 0; k < S.info.y * S.info.z; ++k) tables.tables.at(S.info.x + k);  // in range
   }
+  const QuadSet& S0 = tables.sets.at(B.first);
+  auto direction = [&](std::uint32_t k) {
+    const double theta = double(k) * S0.data.y;
+    return vec3(float(std::sin(theta)), 0.0f, float(std::cos(theta)));
+  };
+  std::vector<double> b5(S0.info.y);  // B5 per theta table: the same for every bin
+  for (std::uint32_t k = 0; k < S0.info.y; ++k) b5[k] = fresnelCosineMoment(direction(k));
+  // A5 per (bin, table), on every core: each writes its own tables (a deterministic result).
+  std::atomic<std::uint32_t> next{0};
+  auto work = [&]() {
+    for (std::uint32_t job; (job = next.fetch_add(1)) < B.count * S0.info.y;) {
+      const std::uint32_t j = job / S0.info.y, k = job % S0.info.y;
+      const QuadSet& S = tables.sets[B.first + j];
+      const std::uint32_t packed = unorm16(fresnelLobeAlbedo(binRoughness(B, j), direction(k))) | (unorm16(b5[k]) << 16);
+      for (std::uint32_t i = 0; i < S.info.z; ++i) tables.tables[S.info.x + k * S.info.z + i].info.w = packed;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned t = 1; t < std::max(1u, std::thread::hardware_concurrency()); ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
 }
 
 SamplerTables buildRoughnessBinTables(RoughnessBins B, const QuadtreeSettings& settings) {

@@ -20,7 +20,7 @@ std::vector<std::pair<std::uint32_t, shared::BrdfParams>> roughnessBinMaterials(
 // lobe at the table's direction weighted by (1 - v.h)^5, by a quadrature over GGX's distribution
 // of half vectors (64 x 64 points, which follow the lobe whatever its width, the near-mirror r = 0 bin included),
 // and B5 = (1 / pi) * integral of (1 - v.h)^5 cos theta_i, by a quadrature over the cosine. Every
-// table, built or not (onlyThetaTables), from its direction on the grid.
+// table, built or not (onlyThetaTables), from its direction on the grid; on every core.
 void setRoughnessBinMoments(SamplerTables& tables, shared::RoughnessBins B);
 
 // The bins alone (B.first must be 0): their tables built with `settings`, with their moments.
