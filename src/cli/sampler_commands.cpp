@@ -143,11 +143,6 @@ void writeSvg(const std::string& path, const quadtree::SamplerTables& t, std::ui
   out << "<text x='10' y='" << 2.1 * S + 20 << "' font-family='monospace' font-size='13'>" << title << "</text>\n</svg>\n";
 }
 
-// `nusselt sample --roughness-bins K`: binned sampling of one gltf_pbr texel (the parameters of
-// --param / --preset) with K roughness bins, as a render samples a gltf_pbr material whose textures
-// vary its parameters. The bins' trees are built at the theta tables the known direction reads
-// only (thetaTablesAround: the sampling there is that of the full grid); pdf in the CSV is the
-// mixture's exact density (binnedPdf), f the texel's.
 // The samples that succeeded as CSV (x,y,z,pdf,f: direction, density per unit solid angle,
 // luminance of f); returns the number of failed ones (not written).
 std::uint64_t writeSamplesCsv(const std::string& path, const quadtree::SampleBatch& b, std::uint32_t n) {
@@ -164,6 +159,11 @@ std::uint64_t writeSamplesCsv(const std::string& path, const quadtree::SampleBat
   return failed;
 }
 
+// `nusselt sample --roughness-bins K`: binned sampling of one gltf_pbr texel (the parameters of
+// --param / --preset) with K roughness bins, as a render samples a gltf_pbr material whose textures
+// vary its parameters. The bins' trees are built at the theta tables the known direction reads
+// only (thetaTablesAround: the sampling there is that of the full grid); pdf in the CSV is the
+// mixture's exact density (binnedPdf), f the texel's.
 int sampleBinned(const SampleArgs& a, const ModelSpec& m, const BrdfParams& p, vec3 v) {
   if (m.id != MODEL_GLTF_PBR)
     throw Error("--roughness-bins: binned sampling is for gltf_pbr (--model gltf_pbr), not " + m.name);
