@@ -179,7 +179,7 @@ SHARED_FN bool bsdfSample(uint strategy, uint model, uint quadSet, BrdfParams p,
 // baseColor 1, metallic 1: F = 1, no diffuse part), one set per bin shared by every such material
 // of the scene (RoughnessBins, quadtree_layout.h); r_j <= r <= r_{j+1} the texel's roughness,
 // t = (r - r_j) / (r_{j+1} - r_j) (binLocate). c_d (binnedDiffuseChoice) weighs the texel's diffuse
-// albedo against its specular one; it is a function of wo and the texel only and at least
+// albedo against its specular one at wo (from the bins' tabulated albedo and Fresnel moments); it is a function of wo and the texel only and at least
 // BIN_COSINE_FLOOR, so the cosine part covers the whole hemisphere whatever the trees do.
 // The sample is weighted with the texel's own f: weight = f cos / pdf, pdf the EXACT mixture density
 // above (binnedPdf), which MIS uses too: unbiased for any bins and any c_d. The component and the
@@ -218,20 +218,53 @@ SHARED_FN BrdfParams binParams(float r) {
   return q;
 }
 
-// The probability c_d of the cosine part for the texel p and wo: its diffuse albedo estimate
-// (1 - lum F(wo.z)) lum(cdiff) against the specular one lum F(wo.z) x the bins' tabulated albedo
-// at wo (quadAlbedo, mixed like the trees), floored at BIN_COSINE_FLOOR.
+// The Fresnel moments of bin `set` at the known direction (cosTheta, phi), interpolated between
+// tables like quadAlbedo: x = A5, the albedo of the bin's lobe weighted by (1 - v.h)^5 (with F = 1
+// the table's mass is A1; Schlick's F = f0 + (1 - f0)(1 - v.h)^5 is linear in f0, so the lobe's
+// albedo with F is f0 A1 + (1 - f0) A5); y = B5 = (1 / pi) * integral of (1 - v.h)^5 cos theta_i
+// over the hemisphere (the diffuse part (1 - F) cdiff / pi has albedo (1 - f0)(1 - B5) cdiff).
+// Stored as two unorm16 in QuadTable.info.w of the bins' tables (setRoughnessBinMoments,
+// src/quadtree/roughness_bins.cpp); 0 where not set (then c_d is the normal-incidence estimate).
+SHARED_FN vec2 binFresnelMoments(uint set, float cosTheta, float phi) {
+  QuadSet S = QT_SET(set);
+  float c = clamp(cosTheta, 0.0f, 1.0f);
+  vec3 v = vec3(cosFromSin(c) * cos(phi), cosFromSin(c) * sin(phi), c);
+  vec4 fr = quadFrame((S.info.w & QT_SET_ANISOTROPIC) != 0u, v);
+  uvec4 idx;
+  vec2 ts;
+  quadGrid(S, quadToCanonical(fr, v), idx, ts);
+  uint np = S.info.z;
+  uint m0 = QT_TABLE(S.info.x + idx.x * np + idx.z).info.w;
+  uint m1 = QT_TABLE(S.info.x + idx.y * np + idx.z).info.w;
+  vec2 a = vec2(float(m0 & 0xffffu), float(m0 >> 16u)) * (1.0f / 65535.0f);
+  vec2 b = vec2(float(m1 & 0xffffu), float(m1 >> 16u)) * (1.0f / 65535.0f);
+  return mix(a, b, ts.x);
+}
+
+// The probability c_d of the cosine part for the texel p and wo: the texel's diffuse albedo at wo,
+// lum((1 - f0) cdiff) (1 - B5), against its specular one, lum(f0) A1 + (1 - lum(f0)) A5, with the
+// bins' tabulated albedo A1 (quadAlbedo) and Fresnel moments (binFresnelMoments) at wo mixed like
+// the trees (exact at the texel's roughness on a bin and a table direction), floored at
+// BIN_COSINE_FLOOR. (Schlick's F at cos theta_o instead, as before, tends to 1 at grazing incidence
+// and gave the lobe most samples there, whatever the diffuse part's share.)
 SHARED_FN float binnedDiffuseChoice(RoughnessBins B, BrdfParams p, vec3 wo, uint j, float t) {
   vec3 base = brdfParam3(p, GLTF_PBR_BASE_COLOR);
   float metallic = clamp(brdfParam(p, GLTF_PBR_METALLIC), 0.0f, 1.0f);
   vec3 f0 = mix(vec3(0.04f), base, metallic);
-  float F = luminance(fresnelSchlick3(wo.z, f0));
-  float d = (1.0f - F) * luminance(base) * (1.0f - metallic);
   float phi = portableAtan2(wo.y, wo.x);
   float a = 0.0f;
-  if (t < 1.0f) a += (1.0f - t) * quadAlbedo(B.first + j, wo.z, phi);
-  if (t > 0.0f) a += t * quadAlbedo(B.first + j + 1u, wo.z, phi);
-  float s = F * a;
+  vec2 m = vec2(0.0f);
+  if (t < 1.0f) {
+    a += (1.0f - t) * quadAlbedo(B.first + j, wo.z, phi);
+    m += (1.0f - t) * binFresnelMoments(B.first + j, wo.z, phi);
+  }
+  if (t > 0.0f) {
+    a += t * quadAlbedo(B.first + j + 1u, wo.z, phi);
+    m += t * binFresnelMoments(B.first + j + 1u, wo.z, phi);
+  }
+  float lf0 = luminance(f0);
+  float d = luminance((vec3(1.0f) - f0) * base) * (1.0f - metallic) * (1.0f - m.y);
+  float s = lf0 * a + (1.0f - lf0) * m.x;
   float cd = d + s > 0.0f ? d / (d + s) : 1.0f;
   return clamp(cd, BIN_COSINE_FLOOR, 1.0f);
 }

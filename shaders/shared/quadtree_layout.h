@@ -66,7 +66,8 @@ struct QuadLeaf {
 };
 STATIC_ASSERT_SIZE(QuadLeaf, 48);
 
-// info = (root node (QT_EMPTY when f = 0 for this direction), bits of cos phi, bits of sin phi, 0);
+// info = (root node (QT_EMPTY when f = 0 for this direction), bits of cos phi, bits of sin phi, 0;
+// the roughness bins' tables: their Fresnel moments, bsdf_sampling.h binFresnelMoments);
 // data = (total mass = directional albedo of the luminance of f, cos theta of the table's fixed
 // direction, phi of it, sin theta). The fixed direction is quadTableDirection(): the builder and
 // the sampler use the same float vector.

@@ -23,6 +23,7 @@
 #include "render/settings.h"
 #include "quadtree/sample_run.h"
 #include "quadtree/quadtree_build.h"
+#include "quadtree/roughness_bins.h"
 #include "quadtree/sampler_tables.h"
 #include "sampling/tabulated.h"
 #include "util/error.h"
@@ -50,6 +51,8 @@ struct SampleArgs {
   std::uint32_t phiTables = 16;
   std::string sampler = "quadtree";
   std::uint64_t tabBytes = 64 * 1024;
+  std::uint32_t roughnessBins = 0;  // > 0: binned sampling of gltf_pbr (bsdf_sampling.h, "Binned sampling")
+  float roughnessBinSpacing = 2.0f;
 };
 
 std::uint32_t strategyId(const std::string& name) {
@@ -140,12 +143,91 @@ void writeSvg(const std::string& path, const quadtree::SamplerTables& t, std::ui
   out << "<text x='10' y='" << 2.1 * S + 20 << "' font-family='monospace' font-size='13'>" << title << "</text>\n</svg>\n";
 }
 
+// The samples that succeeded as CSV (x,y,z,pdf,f: direction, density per unit solid angle,
+// luminance of f); returns the number of failed ones (not written).
+std::uint64_t writeSamplesCsv(const std::string& path, const quadtree::SampleBatch& b, std::uint32_t n) {
+  FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) throw Error("-o " + path + ": cannot write");
+  std::fprintf(f, "x,y,z,pdf,f\n");
+  std::uint64_t failed = 0;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const vec4& w = b.wPdf[i];
+    if (b.fOk[i].w <= 0) { ++failed; continue; }
+    std::fprintf(f, "%.9g,%.9g,%.9g,%.9g,%.9g\n", w.x, w.y, w.z, w.w, luminance(vec3(b.fOk[i])));
+  }
+  if (std::fclose(f) != 0) throw Error("-o " + path + ": cannot write");
+  return failed;
+}
+
+// `nusselt sample --roughness-bins K`: binned sampling of one gltf_pbr texel (the parameters of
+// --param / --preset) with K roughness bins, as a render samples a gltf_pbr material whose textures
+// vary its parameters. The bins' trees are built at the theta tables the known direction reads
+// only (thetaTablesAround: the sampling there is that of the full grid); pdf in the CSV is the
+// mixture's exact density (binnedPdf), f the texel's.
+int sampleBinned(const SampleArgs& a, const ModelSpec& m, const BrdfParams& p, vec3 v) {
+  if (m.id != MODEL_GLTF_PBR)
+    throw Error("--roughness-bins: binned sampling is for gltf_pbr (--model gltf_pbr), not " + m.name);
+  if (strategyId(a.sampler) != SAMPLER_QUADTREE)
+    throw Error("--roughness-bins: binned sampling mixes quadtrees (--sampler quadtree), not --sampler " + a.sampler);
+  if (a.roughnessBins < 2) throw Error("--roughness-bins: at least 2 bins (0: the texel's own tree)");
+  if (!a.svg.empty()) throw Error("--svg draws one tree: not with --roughness-bins");
+  const RoughnessBins B{0u, a.roughnessBins, a.roughnessBinSpacing, 0u};
+  quadtree::QuadtreeSettings qs;
+  qs.thetaTables = a.thetaTables;
+  qs.phiTables = a.phiTables;
+  qs.onlyThetaTables = quadtree::thetaTablesAround(a.thetaDeg, a.thetaTables);
+  const quadtree::SamplerTables tables = quadtree::buildRoughnessBinTables(B, qs);
+  std::uint32_t j;
+  float t;
+  binLocate(B, brdfParam(p, GLTF_PBR_ROUGHNESS), j, t);
+  float cd;
+  {
+    quadtree::QuadHostScope scope(tables);
+    cd = binnedDiffuseChoice(B, p, v, j, t);
+  }
+  quadtree::SampleBatch b;
+  std::string where;
+  if (a.cpu) {
+    b = quadtree::sampleCpu(tables, INVALID_INDEX, m.id, p, v, a.n, a.seed, 0, &B);
+    where = "cpu";
+  } else {
+    vk::Context ctx;
+    vk::ContextOptions opts;
+    opts.deviceIndex = a.device;
+    vk::createContext(ctx, opts);
+    try {
+      b = quadtree::sampleGpu(ctx, tables, INVALID_INDEX, m.id, p, v, a.n, a.seed, SAMPLER_QUADTREE, nullptr, false, 0,
+                              1u << 20, &B);
+    } catch (...) {
+      vk::destroyContext(ctx);
+      throw;
+    }
+    where = ctx.deviceName;
+    vk::destroyContext(ctx);
+  }
+  const std::uint64_t failed = writeSamplesCsv(a.output, b, a.n);
+  std::printf("%s: %u samples (binned: %u bins spaced %g; roughness %g between bin %u (r = %g) and bin %u (r = %g), "
+              "t = %.4g; cosine share c_d = %.4g) on %s in %.3f s; trees: %zu theta tables per bin (%.3f s), %.1f KiB\n",
+              m.name.c_str(), a.n, B.count, B.spacing, brdfParam(p, GLTF_PBR_ROUGHNESS), j, binRoughness(B, j), j + 1,
+              binRoughness(B, j + 1), t, cd, where.c_str(), b.seconds, qs.onlyThetaTables.size(), tables.seconds,
+              tables.bytes() / 1024.0);
+  std::printf("bound violations %llu, trial failures %llu, failed samples %llu\n",
+              static_cast<unsigned long long>(b.boundViolations), static_cast<unsigned long long>(b.trialFailures),
+              static_cast<unsigned long long>(failed));
+  return kExitOk;
+}
+
 int sampleCommand(const SampleArgs& a) {
   const ModelSpec& m = modelOrThrow(a.model);
   if (a.thetaDeg < 0 || a.thetaDeg >= 90) throw Error("--theta must lie in [0, 90)");
   if (!m.measured && !a.file.empty()) throw Error("--file: only measured models (merl) read a file");
   BrdfParams p = m.measured ? measuredParams(m, a.file, a.params) : paramsFor(m, a.preset, a.params);
   const std::uint32_t strategy = strategyId(a.sampler);
+  if (a.roughnessBins > 0) {
+    double th = a.thetaDeg * M_PI / 180, ph = a.phiDeg * M_PI / 180;
+    return sampleBinned(a, m, p,
+                        vec3(float(std::sin(th) * std::cos(ph)), float(std::sin(th) * std::sin(ph)), float(std::cos(th))));
+  }
   if (strategy != SAMPLER_QUADTREE && !a.svg.empty()) throw Error("--svg draws the quadtree: only with --sampler quadtree");
   double th = a.thetaDeg * M_PI / 180, ph = a.phiDeg * M_PI / 180;
   vec3 v(float(std::sin(th) * std::cos(ph)), float(std::sin(th) * std::sin(ph)), float(std::cos(th)));
@@ -190,16 +272,7 @@ int sampleCommand(const SampleArgs& a) {
     where = ctx.deviceName;
     vk::destroyContext(ctx);
   }
-  FILE* f = std::fopen(a.output.c_str(), "w");
-  if (!f) throw Error("-o " + a.output + ": cannot write");
-  std::fprintf(f, "x,y,z,pdf,f\n");
-  std::uint64_t failed = 0;
-  for (std::uint32_t i = 0; i < a.n; ++i) {
-    const vec4& w = b.wPdf[i];
-    if (b.fOk[i].w <= 0) { ++failed; continue; }
-    std::fprintf(f, "%.9g,%.9g,%.9g,%.9g,%.9g\n", w.x, w.y, w.z, w.w, luminance(vec3(b.fOk[i])));
-  }
-  std::fclose(f);
+  const std::uint64_t failed = writeSamplesCsv(a.output, b, a.n);
   if (strategy == SAMPLER_QUADTREE) {
     const quadtree::MaterialStats& st = tables.materials[0];
     std::printf("%s: %u samples on %s in %.3f s; trees: %u (%s, %.3f s), %u nodes, %u leaves, %.1f KiB\n", m.name.c_str(),
@@ -354,6 +427,13 @@ void registerSamplerCommands(CLI::App& app, CLI::App& bench, CommandRunner& run)
       ->capture_default_str()->check(CLI::IsMember(enumNames(kSamplerNames)));
   sample->add_option("--tab-bytes", sa->tabBytes, "tabulated: memory budget of one table in bytes (sets the grid)")
       ->capture_default_str()->check(CLI::Range(std::uint64_t(1024), std::uint64_t(1) << 30));
+  sample->add_option("--roughness-bins", sa->roughnessBins, "gltf_pbr: binned sampling with K roughness bins, as renders "
+                                                          "sample gltf_pbr whose textures vary its parameters (0: the "
+                                                          "texel's own tree; docs/scenes.md)")
+      ->capture_default_str()->check(CLI::Range(0u, 64u));
+  sample->add_option("--roughness-bin-spacing", sa->roughnessBinSpacing, "with --roughness-bins: bin j of K at roughness "
+                                                                      "(j / (K - 1))^spacing")
+      ->capture_default_str()->check(CLI::Range(0.25f, 4.0f));
   sample->callback([sa, &run]() { run = [sa]() { return sampleCommand(*sa); }; });
 
   auto ba = std::make_shared<BenchArgs>();

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <memory>
 #include <stdexcept>
@@ -18,7 +19,7 @@ namespace nusselt::quadtree {
 using namespace shared;
 
 SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint32_t model, const BrdfParams& params, vec3 v,
-                      std::uint32_t n, std::uint32_t seed, unsigned threads) {
+                      std::uint32_t n, std::uint32_t seed, unsigned threads, const RoughnessBins* bins) {
   auto t0 = std::chrono::steady_clock::now();
   SampleBatch out;
   out.wPdf.assign(n, vec4(0.0f));
@@ -34,7 +35,7 @@ SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint3
       vec2 u = rng2(i, 0u, RNG_DIM_BSDF, seed);
       vec3 w, f;
       float pdf;
-      bool ok = quadSample(set, model, params, v, u, w, pdf, f);
+      bool ok = bins ? binnedSample(*bins, params, v, u, w, pdf, f) : quadSample(set, model, params, v, u, w, pdf, f);
       out.wPdf[i] = vec4(w, ok ? pdf : 0.0f);
       out.fOk[i] = vec4(f, ok ? 1.0f : 0.0f);
     }
@@ -61,6 +62,15 @@ SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint3
       out.leafAccepted[l] += leafAcc[t][l];
     }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+std::vector<std::uint32_t> thetaTablesAround(double thetaDeg, std::uint32_t thetaTables) {
+  const double step = 90.0 / thetaTables;
+  const long k = long(std::floor(thetaDeg / step));
+  std::vector<std::uint32_t> out;
+  for (long i = k - 1; i <= k + 2; ++i)
+    if (i >= 0 && i < long(thetaTables)) out.push_back(std::uint32_t(i));
   return out;
 }
 

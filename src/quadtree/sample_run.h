@@ -24,8 +24,16 @@ struct SampleBatch {
   double medianSecondsPerSample = 0;  // GPU with timingRepeats > 0: median of the repeated timings
 };
 
+// bins (model gltf_pbr): binned sampling (bsdf_sampling.h, binnedSample) of the texel parameters
+// `params` with the bins' sets bins->first .. of `tables`, as sampleGpu's; `set` is unused then.
 SampleBatch sampleCpu(const SamplerTables& tables, std::uint32_t set, std::uint32_t model, const shared::BrdfParams& params,
-                      shared::vec3 v, std::uint32_t n, std::uint32_t seed, unsigned threads = 0);
+                      shared::vec3 v, std::uint32_t n, std::uint32_t seed, unsigned threads = 0,
+                      const shared::RoughnessBins* bins = nullptr);
+
+// The theta tables that lookups at the known direction thetaDeg read (quadGrid: the two around it),
+// with one more on each side for the float rounding of the angle: a build of only these
+// (QuadtreeSettings::onlyThetaTables) samples that direction as the full grid does.
+std::vector<std::uint32_t> thetaTablesAround(double thetaDeg, std::uint32_t thetaTables);
 
 // The other strategies (SAMPLER_COSINE, SAMPLER_UNIFORM, SAMPLER_ANALYTIC, SAMPLER_TABULATED of
 // shaders/shared/bsdf_sampling.h) on the CPU, with the same random numbers. tabulated needs `tab`

@@ -10,6 +10,7 @@
 #include "../../shaders/shared/layout.h"
 #include "brdf/albedo.h"
 #include "brdf/merl.h"
+#include "quadtree/roughness_bins.h"
 #include "quadtree/sampler_tables.h"
 #include "render/texture_table.h"
 #include "sampling/tabulated.h"
@@ -132,10 +133,8 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     if (!(settings.roughnessBinSpacing > 0.0f) || !std::isfinite(settings.roughnessBinSpacing))
       throw Error("the roughness bins' spacing must be a positive number");
     m_bins = shared::RoughnessBins{0u, settings.roughnessBins, settings.roughnessBinSpacing, 0u};
-    for (std::uint32_t j = 0; j < settings.roughnessBins; ++j) {
-      toBuild.push_back({MODEL_GLTF_PBR, shared::binParams(shared::binRoughness(m_bins, j))});
-      uses.push_back({INVALID_INDEX, static_cast<int>(j)});
-    }
+    toBuild = quadtree::roughnessBinMaterials(m_bins);
+    for (std::uint32_t j = 0; j < settings.roughnessBins; ++j) uses.push_back({INVALID_INDEX, static_cast<int>(j)});
   }
   if (settings.sampler == SamplerKind::Quadtree || settings.sampler == SamplerKind::Tabulated)
     for (std::size_t i = 0; i < scene.materials.size(); ++i) {
@@ -190,6 +189,7 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
   if (anyBinned) {
     for (std::uint32_t j = 0; j < m_bins.count; ++j)
       if (setOf[j] != j) throw Error("internal: the roughness bins are not the first quadtree sets");
+    quadtree::setRoughnessBinMoments(qt, m_bins);
     m_plan.roughnessBins = m_bins.count;
     for (const quadtree::MaterialStats& st : qt.materials)
       if (st.set < m_bins.count) m_plan.binBytes += st.bytes;

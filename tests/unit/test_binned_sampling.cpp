@@ -18,6 +18,7 @@
 
 #include "../../shaders/shared/bsdf_sampling.h"
 #include "brdf/albedo.h"
+#include "quadtree/roughness_bins.h"
 #include "test_quadtree_chi2.h"
 
 using namespace nusselt;
@@ -57,16 +58,10 @@ BrdfParams texel(const BinCase& c) {
   return p;
 }
 
-// The bins' trees (4 uniform bins), tables only at the cases' angles, built once.
+// The bins' trees (4 uniform bins) and Fresnel moments, tables only at the cases' angles, built once.
 const quadtree::SamplerTables& binTables() {
   static quadtree::SamplerTables t = [] {
-    RoughnessBins B{0u, kBins, 1.0f, 0u};
-    std::vector<std::pair<std::uint32_t, BrdfParams>> m;
-    for (std::uint32_t j = 0; j < kBins; ++j) m.push_back({MODEL_GLTF_PBR, binParams(binRoughness(B, j))});
-    std::vector<std::uint32_t> idx;
-    quadtree::SamplerTables out = quadtree::buildSamplerTables(m, qttest::testSettings(), idx);
-    for (std::uint32_t j = 0; j < kBins; ++j) EXPECT_EQ(idx[j], j);
-    return out;
+    return quadtree::buildRoughnessBinTables(RoughnessBins{0u, kBins, 1.0f, 0u}, qttest::testSettings());
   }();
   return t;
 }
@@ -145,4 +140,32 @@ TEST(BinnedSampling, BinsAroundARoughness) {
     EXPECT_GE(r1, r) << r;
     EXPECT_NEAR(t, (r - r0) / (r1 - r0), 1e-6f) << r;
   }
+}
+
+// The bins' Fresnel moments (binFresnelMoments, which c_d reads) rebuild the texel's albedo: at a
+// roughness on a bin and a table direction, lum((1 - f0) cdiff)(1 - B5) + lum(f0) A1 + (1 - lum(f0)) A5
+// (A1 the table's mass) is the texel's directionalAlbedo, up to the moments' 64 x 64 midpoint
+// rules and unorm16 storage and the quadrature of directionalAlbedo: within 1% + 1e-3 (deterministic).
+TEST(BinnedSampling, FresnelMomentsGiveTheTexelAlbedo) {
+  const RoughnessBins B{0u, kBins, 1.0f, 0u};
+  quadtree::QuadHostScope scope(binTables());
+  for (std::uint32_t j : {0u, 1u, 2u, 3u})
+    for (float metallic : {0.0f, 0.5f, 1.0f})
+      for (double theta : {0.0, 30.0, 60.0, 85.0}) {
+        const vec3 base(0.8f, 0.5f, 0.3f);
+        BrdfParams p{};
+        p.v[0] = vec4(base, metallic);
+        p.v[GLTF_PBR_ROUGHNESS / 4u][GLTF_PBR_ROUGHNESS % 4u] = binRoughness(B, j);
+        const vec3 v = qttest::knownDirection(qttest::Case{"gltf_pbr", false, theta, 0});
+        const vec2 m = binFresnelMoments(j, v.z, 0.0f);
+        const float a1 = quadAlbedo(j, v.z, 0.0f);
+        const vec3 f0 = mix(vec3(0.04f), base, metallic);
+        const double lf0 = luminance(f0);
+        const double d = luminance((vec3(1.0f) - f0) * base) * (1.0 - metallic) * (1.0 - m.y);
+        const double s = lf0 * a1 + (1 - lf0) * m.x;
+        const double ref = directionalAlbedo(MODEL_GLTF_PBR, p, theta);
+        std::printf("r %.3f metallic %.1f theta %4.1f: A1 %.5f A5 %.5f B5 %.5f; diffuse %.5f + specular %.5f = %.5f, "
+                    "albedo %.5f\n", binRoughness(B, j), metallic, theta, a1, m.x, m.y, d, s, d + s, ref);
+        EXPECT_NEAR(d + s, ref, 0.01 * ref + 1e-3) << "r " << binRoughness(B, j) << " metallic " << metallic << " theta " << theta;
+      }
 }
