@@ -34,6 +34,11 @@
                  tints the light it transmits at each of its two faces (KHR_materials_transmission's
                  tinting; KHR_materials_volume: a coloured foil on the boundary): at normal
                  incidence the emitter converges to c^2 (1 - R) / (1 + R) per channel.
+  thin_rough_sheet.gltf  a thin-walled rough sheet (KHR_materials_transmission 1, ior 1.5,
+                 roughness 0.7, metallic 0, baseColorFactor (0.8, 0.5, 0.2), no KHR_materials_volume:
+                 the loader's rough_thin_dielectric, alpha 0.49) at z = 0.3, 6 x 6, facing +z, over
+                 an emitter of radiance 1 at z = 0, 2 x 2, facing +z; camera above, looking down.
+                 The lamp is seen through the sheet blurred, tinted by the base colour.
   guiding_gap.gltf  two rooms (4 x 2 x 2, Lambert rho 0.7) divided by a wall at x = 0 with a
                  0.3 x 0.3 opening at its centre; the area light is on the ceiling of the left room,
                  the camera in the right one: the right room sees light only through the opening
@@ -462,6 +467,21 @@ def glass_slab_base_color():
     slab_scene("coloured", {"thicknessFactor": 0.2}, "glass_slab_base_color.gltf", base_color=(0.8, 0.5, 0.2))
 
 
+def thin_rough_sheet():
+    b = Builder()
+    b.use("KHR_materials_transmission")
+    b.use("KHR_materials_ior")
+    sheet = b.pbr_material("frosted pane", {"metallicFactor": 0.0, "roughnessFactor": 0.7,
+                                            "baseColorFactor": [0.8, 0.5, 0.2, 1.0]},
+                           extensions={"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                                       "KHR_materials_ior": {"ior": 1.5}})
+    lamp = b.material("lamp", 0.0, emission=(1.0, 1.0, 1.0))
+    b.quad("lamp", [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], lamp)
+    b.quad("sheet", [[-3, -3, 0.3], [3, -3, 0.3], [3, 3, 0.3], [-3, 3, 0.3]], sheet)
+    b.camera("camera", (0.0, 0.0, 3.0), (0.0, 0.0, 0.0), 0.3, 1.0)
+    b.write("thin_rough_sheet.gltf")
+
+
 def guiding_gap():
     b = Builder()
     white = b.material("white", 0.7)
@@ -494,4 +514,5 @@ if __name__ == "__main__":
     glass_slab()
     glass_slab_tinted()
     glass_slab_base_color()
+    thin_rough_sheet()
     guiding_gap()

@@ -199,7 +199,7 @@ const std::vector<Family>& families() {
   static const std::vector<Family> f = {
       {"Diffuse", {"lambert", "oren_nayar", "minnaert"}},
       {"Phong-like lobes", {"phong_specular", "phong", "lewis", "blinn", "ashikhmin_shirley", "lafortune"}},
-      {"Microfacet and physically based", {"torrance_sparrow", "ward", "gltf_pbr", "coupled", "beard_maxwell", "htsg", "rough_dielectric"}},
+      {"Microfacet and physically based", {"torrance_sparrow", "ward", "gltf_pbr", "coupled", "beard_maxwell", "htsg", "rough_dielectric", "rough_thin_dielectric"}},
       {"Other empirical", {"schlick", "strauss", "poulin_fournier"}},
   };
   return f;

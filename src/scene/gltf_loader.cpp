@@ -1328,12 +1328,13 @@ class Converter {
   // transmission does. w = 1: the dielectric alone. The dielectric refracts (`dielectric`) when
   // KHR_materials_volume gives the mesh a thickness (thicknessFactor > 0); otherwise the surface is
   // thin-walled, as the extension defines, and light passes straight through (`thin_dielectric`).
-  // Rough transmission: a refracting volume (thicknessFactor > 0) with w = 1, no transmission
-  // texture and roughnessFactor r > 0 is `rough_dielectric` alone, alpha = r^2 (clamped to the
-  // model's [0.001, 1]) and eta = ior (clamped to its [1.01, 4], named in a warning when clamped);
-  // the microfacet roughness blurs reflection and refraction alike. Partial or textured rough
-  // transmission and thin-walled rough transmission stay smooth, named in a warning (the renderer
-  // takes rough_dielectric as a material of its own only: material_table.cpp).
+  // Rough transmission: w = 1, no transmission texture and roughnessFactor r > 0 is
+  // `rough_dielectric` alone with a refracting volume (thicknessFactor > 0), `rough_thin_dielectric`
+  // alone when thin-walled; alpha = r^2 (clamped to the model's [0.001, 1]) and eta = ior (clamped
+  // to its [1.01, 4], named in a warning when clamped); the microfacet roughness blurs reflection
+  // and transmission alike. Partial (w < 1) or textured rough transmission stays smooth, named in
+  // a warning (the renderer takes the rough models as materials of their own only:
+  // material_table.cpp).
   void transmissiveMaterial(Material& m, const std::string& context) {
     const float w = m.transmissionFactor * (1.0f - m.metallicFactor);
     if (!(w > 0.0f)) return;
@@ -1347,12 +1348,12 @@ class Converter {
     // shade_body.glsl) colours the transmitted light at every crossing of the surface.
     const ParamValue tint = arrayValue({ParamValue::num(m.baseColorFactor[0]), ParamValue::num(m.baseColorFactor[1]),
                                         ParamValue::num(m.baseColorFactor[2])});
-    if (r > 0.0f && !thin && w >= 1.0f && !textured) {
-      const ModelSpec& rough = *findModel("rough_dielectric");
+    if (r > 0.0f && w >= 1.0f && !textured) {
+      const ModelSpec& rough = *findModel(thin ? "rough_thin_dielectric" : "rough_dielectric");
       const float eta = std::clamp(m.ior, 1.01f, 4.0f);
       if (eta != m.ior)
         warnOnce("KHR_materials_ior " + fmt(m.ior) + " of a rough transmitting material is rendered as " + fmt(eta) +
-                 " (rough_dielectric's eta is in [1.01, 4])");
+                 " (" + rough.name + "'s eta is in [1.01, 4])");
       m.model = rough.id;
       m.params = packParams(rough, {{"alpha", ParamValue::num(std::clamp(r * r, 0.001f, 1.0f))},
                                     {"eta", ParamValue::num(eta)}, {"tint", tint}},
@@ -1361,9 +1362,9 @@ class Converter {
     }
     if (r > 0.0f)
       warnOnce(std::string("roughnessFactor > 0 of a transmitting material is rendered as smooth transmission when ") +
-               (thin ? "it is thin-walled (no KHR_materials_volume thicknessFactor > 0)"
-                     : "transmissionFactor x (1 - metallic) < 1 or a transmissionTexture applies") +
-               " (rough transmission renders only as rough_dielectric alone; docs/scenes.md, \"Transmission\")");
+               (textured ? "a transmissionTexture applies" : "transmissionFactor x (1 - metallic) < 1") +
+               " (rough transmission renders only as rough_dielectric or rough_thin_dielectric alone; docs/scenes.md, "
+               "\"Transmission\")");
     const ModelSpec& glassModel = *findModel(thin ? "thin_dielectric" : "dielectric");
     BrdfParams glass = packParams(glassModel, {{"eta", ParamValue::num(std::min(m.ior, 10.0f))}, {"tint", tint}},
                                   context + " (transmission)");

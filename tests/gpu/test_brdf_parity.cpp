@@ -76,3 +76,35 @@ TEST(BrdfParity, CpuAndGpuEvaluateTheSameFunction) {
   EXPECT_EQ(failedSets, 0);
   EXPECT_EQ(test::validationMessages(), 0u);
 }
+
+// The transmitting models (ModelSpec::transmits: rough_dielectric, rough_thin_dielectric) across
+// the surface and from the back: the same direction pairs with wi turned below the surface
+// (transmission), and with both below (the back side), the bound as above.
+TEST(BrdfParity, TransmittingModelsAgreeBelowTheSurface) {
+  const int n = 10000;
+  std::vector<std::pair<vec3, vec3>> pairs = directionPairs(4321, n);
+  for (int k = 0; k < n; ++k) {
+    vec3& wi = pairs[std::size_t(k)].first;
+    wi.z = -wi.z;
+    if (k % 2) pairs[std::size_t(k)].second.z = -pairs[std::size_t(k)].second.z;  // both below
+  }
+  test::BrdfParityKernel kernel(pairs);
+  const float ulp = std::ldexp(1.0f, -23);
+  int models = 0;
+  for (const ModelSpec& model : allModels()) {
+    if (!model.transmits) continue;
+    ++models;
+    for (auto& [setName, values] : {std::pair{std::string("typical"), typicalParams(model)},
+                                    std::pair{std::string("hard"), hardParams(model)}}) {
+      BrdfParams params = packParams(model, values, model.name + "/" + setName);
+      test::BrdfParityKernel::Result r = kernel.run(model.id, params);
+      std::printf("[parity below] %-22s %-8s worst relative difference %.3g (%.1f ulp), worst |diff|/bound %.3f\n",
+                  model.name.c_str(), setName.c_str(), r.worstRel, r.worstRel / ulp, r.worstRatio);
+      EXPECT_EQ(r.nonFinite, 0) << model.name << "/" << setName;
+      EXPECT_EQ(r.outside, 0) << model.name << "/" << setName << ": worst at pair " << r.worstIndex << ", |diff|/bound "
+                              << r.worstRatio;
+    }
+  }
+  EXPECT_EQ(models, 2);
+  EXPECT_EQ(test::validationMessages(), 0u);
+}

@@ -567,8 +567,8 @@ TEST(GltfTextures, TransmissionBecomesTheDielectric) {
 // w = transmissionFactor x (1 - metallic) = 1 and no transmissionTexture: rough_dielectric alone,
 // alpha = r^2, eta = ior (default 1.5; clamped to the model's [1.01, 4] with a warning), the
 // volume's absorption as for the smooth dielectric. glTF's default roughnessFactor is 1. The
-// smooth case (r = 0) stays the dielectric; partial, textured or thin-walled rough transmission
-// stays smooth and is named in a warning.
+// smooth case (r = 0) stays the dielectric; partial or textured rough transmission stays smooth
+// and is named in a warning (thin-walled: the next test).
 TEST(GltfTextures, RoughTransmissionBecomesRoughDielectric) {
   Json j = texturedQuad();
   j["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"};
@@ -609,10 +609,59 @@ TEST(GltfTextures, RoughTransmissionBecomesRoughDielectric) {
   EXPECT_EQ(p.materials[0].components[1].model, MODEL_DIELECTRIC);
   EXPECT_TRUE(hasWarning(p, "roughnessFactor > 0 of a transmitting material is rendered as smooth transmission when "
                             "transmissionFactor x (1 - metallic) < 1"));
-  // Thin-walled rough transmission: thin_dielectric, named.
-  Scene t = material(R"(, "roughnessFactor": 0.5)", full);
-  EXPECT_EQ(t.materials[0].model, MODEL_THIN_DIELECTRIC);
-  EXPECT_TRUE(hasWarning(t, "rendered as smooth transmission when it is thin-walled"));
+}
+
+// Thin-walled rough transmission (no KHR_materials_volume, or thicknessFactor 0) with w = 1 and no
+// transmissionTexture: rough_thin_dielectric alone (issue 18), alpha = r^2, eta = ior (clamped to
+// the model's [1.01, 4], named), tint = baseColorFactor, no absorption and no warning. r = 0 stays
+// thin_dielectric; partial (w < 1) and textured rough transmission stay the smooth combination
+// with thin_dielectric, each named in the warning for exactly its case.
+TEST(GltfTextures, ThinWalledRoughTransmissionBecomesRoughThinDielectric) {
+  Json j = texturedQuad();
+  j["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"};
+  auto material = [&](const std::string& pbr, const std::string& extensions) {
+    j["materials"][0] = Json::parse(R"({"name": "frosted pane", "pbrMetallicRoughness": {"metallicFactor": 0,
+      "baseColorFactor": [0.8, 0.5, 0.2, 1])" + pbr + R"(}, "extensions": {)" + extensions + "}}");
+    return loadJson(j);
+  };
+  auto param = [](const Material& m, std::uint32_t i) { return m.params.v[i / 4][i % 4]; };
+  const std::string full = R"("KHR_materials_transmission": {"transmissionFactor": 1})";
+  for (const char* volume : {"", R"(, "KHR_materials_volume": {"thicknessFactor": 0})"}) {
+    Scene s = material(R"(, "roughnessFactor": 0.5)", full + R"(, "KHR_materials_ior": {"ior": 1.33})" + volume);
+    const Material& m = s.materials[0];
+    EXPECT_FALSE(m.combined()) << volume;
+    EXPECT_EQ(m.model, MODEL_ROUGH_THIN_DIELECTRIC) << volume;
+    EXPECT_FLOAT_EQ(param(m, ROUGH_THIN_DIELECTRIC_ALPHA), 0.25f);
+    EXPECT_FLOAT_EQ(param(m, ROUGH_THIN_DIELECTRIC_ETA), 1.33f);
+    EXPECT_EQ(shared::brdfParam3(m.params, ROUGH_THIN_DIELECTRIC_TINT), glm::vec3(0.8f, 0.5f, 0.2f));
+    EXPECT_EQ(m.absorption, glm::vec3(0.0f));
+    EXPECT_FALSE(hasWarning(s, "rendered as smooth transmission")) << volume;
+    EXPECT_FALSE(hasWarning(s, "read but not rendered yet")) << volume;
+  }
+  // glTF's default roughness 1; ior 5 clamped to the model's 4 (named).
+  Scene c = material("", full + R"(, "KHR_materials_ior": {"ior": 5})");
+  EXPECT_EQ(c.materials[0].model, MODEL_ROUGH_THIN_DIELECTRIC);
+  EXPECT_FLOAT_EQ(param(c.materials[0], ROUGH_THIN_DIELECTRIC_ALPHA), 1.0f);
+  EXPECT_FLOAT_EQ(param(c.materials[0], ROUGH_THIN_DIELECTRIC_ETA), 4.0f);
+  EXPECT_TRUE(hasWarning(c, "KHR_materials_ior 5 of a rough transmitting material is rendered as 4 "
+                            "(rough_thin_dielectric's eta is in [1.01, 4])"));
+  // Smooth (r = 0): thin_dielectric, as before.
+  EXPECT_EQ(material(R"(, "roughnessFactor": 0)", full).materials[0].model, MODEL_THIN_DIELECTRIC);
+  // Partial: the smooth combination with thin_dielectric, named as partial (not as textured).
+  Scene p = material(R"(, "roughnessFactor": 0.5)", R"("KHR_materials_transmission": {"transmissionFactor": 0.5})");
+  ASSERT_EQ(p.materials[0].components.size(), 2u);
+  EXPECT_EQ(p.materials[0].components[1].model, MODEL_THIN_DIELECTRIC);
+  EXPECT_TRUE(hasWarning(p, "roughnessFactor > 0 of a transmitting material is rendered as smooth transmission when "
+                            "transmissionFactor x (1 - metallic) < 1 (rough transmission renders only as "
+                            "rough_dielectric or rough_thin_dielectric alone"));
+  EXPECT_FALSE(hasWarning(p, "transmissionTexture"));
+  // Textured (w = 1): the combination, named as textured (not as partial).
+  Scene t = material(R"(, "roughnessFactor": 0.5)",
+                     R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"index": 0}})");
+  ASSERT_EQ(t.materials[0].components.size(), 2u);
+  EXPECT_EQ(t.materials[0].components[1].model, MODEL_THIN_DIELECTRIC);
+  EXPECT_TRUE(hasWarning(t, "rendered as smooth transmission when a transmissionTexture applies"));
+  EXPECT_FALSE(hasWarning(t, "transmissionFactor x (1 - metallic) < 1"));
 }
 
 // transmissionTexture applies to the transmission combination: the material stays combined
@@ -631,7 +680,9 @@ TEST(GltfTextures, TransmissionTextureKeepsTheCombination) {
   EXPECT_FLOAT_EQ(m.components[0].weight, 0.0f);
   EXPECT_EQ(m.components[1].model, MODEL_THIN_DIELECTRIC);
   EXPECT_FLOAT_EQ(m.components[1].weight, 1.0f);
-  EXPECT_FALSE(hasWarning(s, "transmissionTexture"));
+  // (Applied, so not named as unrendered; glTF's default roughness 1 is named as rendered smooth
+  // because of the texture: ThinWalledRoughTransmissionBecomesRoughThinDielectric.)
+  EXPECT_FALSE(hasWarning(s, "not rendered yet: transmissionTexture"));
   j["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 1;
   Scene metal = loadJson(j);
   EXPECT_FALSE(metal.materials[0].transmissionTextured);

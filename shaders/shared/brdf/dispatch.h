@@ -23,9 +23,12 @@ SHARED_FN bool modelIsDelta(uint model) {
 
 // Models whose f is not zero below the surface (<NAME>_TRANSMITS 1 in the model's header,
 // ModelSpec::transmits; RoughDielectric.CatalogueAndDispatch keeps the two equal):
-// rough_dielectric. A sample or a light sample of theirs may lie on either side; their
-// parameters differ with the side the path is on (transmissionInsideParams).
-SHARED_FN bool modelTransmits(uint model) { return ROUGH_DIELECTRIC_TRANSMITS != 0 && model == MODEL_ROUGH_DIELECTRIC; }
+// rough_dielectric and rough_thin_dielectric. A sample or a light sample of theirs may lie on
+// either side; their parameters may differ with the side the path is on (transmissionInsideParams).
+SHARED_FN bool modelTransmits(uint model) {
+  return (ROUGH_DIELECTRIC_TRANSMITS != 0 && model == MODEL_ROUGH_DIELECTRIC) ||
+         (ROUGH_THIN_DIELECTRIC_TRANSMITS != 0 && model == MODEL_ROUGH_THIN_DIELECTRIC);
+}
 
 // The offset of a model's `tint` parameter (the colour of the light it transmits at each crossing:
 // glTF's base colour on KHR_materials_transmission), or INVALID_INDEX for a model without one.
@@ -33,12 +36,13 @@ SHARED_FN uint modelTintParam(uint model) {
   if (model == MODEL_DIELECTRIC) return DIELECTRIC_TINT;
   if (model == MODEL_THIN_DIELECTRIC) return THIN_DIELECTRIC_TINT;
   if (model == MODEL_ROUGH_DIELECTRIC) return ROUGH_DIELECTRIC_TINT;
+  if (model == MODEL_ROUGH_THIN_DIELECTRIC) return ROUGH_THIN_DIELECTRIC_TINT;
   return INVALID_INDEX;
 }
 
 // The parameters of a transmitting model seen from the inside (the -z side of its frame) in the
 // frame turned over (inside = +z), so that f(wi, wo; p) = f(flipZ(wi), flipZ(wo); inside(p)); p for
-// every other model.
+// every other model, and for rough_thin_dielectric, whose sheet has the same medium on both sides.
 SHARED_FN BrdfParams transmissionInsideParams(uint model, BrdfParams p) {
   if (model == MODEL_ROUGH_DIELECTRIC) return roughDielectricInside(p);
   return p;
@@ -91,7 +95,7 @@ SHARED_FN float deltaChoiceAlbedo(uint model, BrdfParams p, vec3 wo, bool larges
 #define NUSSELT_ETA_SCALE(id, NAME, fn) NUSSELT_CAT(NUSSELT_ETA_SCALE_, NAME##_DELTA)(NAME, fn)
 // The factor by which a refraction's radiance scaling (n_wo / n_wi)^2 is undone for the throughput
 // roulette (pbrt's and Mitsuba's etaScale): (n_wi / n_wo)^2 for a sample of `model` that crossed the
-// surface, 1 for everything else. Delta models take their parameters and `inside`; a transmitting
+// surface, 1 for everything else (rough_thin_dielectric too: the same medium on both sides). Delta models take their parameters and `inside`; a transmitting
 // non-delta model (modelTransmits) its parameters as seen from wo's side (transmissionInsideParams
 // applied inside), which already say the side.
 SHARED_FN float transmissionEtaScale(uint model, BrdfParams p, bool inside) {

@@ -34,6 +34,7 @@
 #include "merl.h"
 #include "thin_dielectric.h"
 #include "rough_dielectric.h"
+#include "rough_thin_dielectric.h"
 
 // X(id, NAME, fn): MODEL_<NAME> = id; <NAME>_DELTA, <NAME>_ANALYTIC and the functions <fn>Eval,
 // <fn>Spec, ... come from the model's header.
@@ -60,7 +61,8 @@
   X(19u, GLTF_PBR, gltfPbr)                \
   X(20u, MERL, merl)                       \
   X(21u, THIN_DIELECTRIC, thinDielectric)   \
-  X(22u, ROUGH_DIELECTRIC, roughDielectric)
+  X(22u, ROUGH_DIELECTRIC, roughDielectric) \
+  X(23u, ROUGH_THIN_DIELECTRIC, roughThinDielectric)
 
 // The models the dispatch switches below and in analytic_sampling.h contain: all of them, or
 // only one in a shade module built for a single model (CMakeLists.txt: -DNUSSELT_SHADE_MODEL_ID,
