@@ -184,8 +184,10 @@ STATIC_ASSERT_SIZE(GpuMaterial, 192);
 
 // One term w * f_k of a combined material (shaders/shared/combined.h).
 // info = (model id, quadtree set index or INVALID_INDEX, 1 for a gltf_pbr component sampled by the
-// roughness bins (binned sampling: its textures vary it) else 0, 0); data = (weight w, 0, 0, 0);
-// albedoLo, albedoHi = the component's directional albedo (without w) at cos theta_o = i / 7, i = 0..3
+// roughness bins (binned sampling: its textures vary it) else 0, the set of a transmitting non-delta
+// component seen from the inside (transmissionInsideParams) or INVALID_INDEX); data = (weight w, 0, 0, 0);
+// albedoLo, albedoHi = the component's directional albedo (without w; a transmitting component's
+// over both hemispheres, R + T, seen from outside) at cos theta_o = i / 7, i = 0..3
 // in albedoLo and 4..7 in albedoHi, computed on the CPU: its largest RGB channel under the throughput
 // roulette (every non-delta component), its luminance under the albedo roulette (components without
 // a QuadSet; quadtree components then use quadAlbedo). The choice probability must be known before

@@ -347,10 +347,22 @@ struct ShadeMaterial {
   bool lightSamples; // no delta flag on the material
 };
 
+// A transmitting non-delta component (rough_dielectric) seen from the inside: its parameters from
+// there (transmissionInsideParams) and their tables (GpuComponent.info.w), as a single-model
+// material takes them (delta components handle the side in their own sampling).
+void insideComponent(uint model, inout GpuComponent C) {
+  if (!modelTransmits(model) || modelIsDelta(model)) return;
+  C.params = transmissionInsideParams(model, C.params);
+  C.info.y = C.info.w;
+}
+
+// Whether component `model` scatters below the surface with a density (light samples there).
+bool componentTransmits(uint model) { return modelTransmits(model) && !modelIsDelta(model); }
+
 // hit: a textured material's components take the textures at the hit (texturedParams: gltf_pbr's
 // base colour and metallic-roughness, the transmitting models' tint), and the transmission
-// texture's R (transmissionAt) sets the weights below. inside: unused (only delta components
-// transmit here; the renderer refuses transmitting non-delta components).
+// texture's R (transmissionAt) sets the weights below. inside: the path arrived from the inside
+// (insideComponent).
 ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, ShadeHit hit, bool inside) {
   ShadeMaterial m;
   m.a = vec4(0.0f);
@@ -370,6 +382,12 @@ ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, Shade
     if (COMPONENT_COUNT > 1u) texturedParams(MODEL_1, base, mr, m.C1.params);
     if (COMPONENT_COUNT > 2u) texturedParams(MODEL_2, base, mr, m.C2.params);
     if (COMPONENT_COUNT > 3u) texturedParams(MODEL_3, base, mr, m.C3.params);
+  }
+  if (inside) {
+    if (COMPONENT_COUNT > 0u) insideComponent(MODEL_0, m.C0);
+    if (COMPONENT_COUNT > 1u) insideComponent(MODEL_1, m.C1);
+    if (COMPONENT_COUNT > 2u) insideComponent(MODEL_2, m.C2);
+    if (COMPONENT_COUNT > 3u) insideComponent(MODEL_3, m.C3);
   }
   // The transmission combination {gltf_pbr, 1 - w; glass, w} under a transmission texture: the
   // glass takes w R at this hit, gltf_pbr the rest (Material::transmissionTextured).
@@ -395,7 +413,12 @@ ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, Shade
 
 bool shadeLightSamples(ShadeMaterial m) { return m.lightSamples; }
 
-bool shadeTransmits(ShadeMaterial m) { return false; }
+// A transmitting non-delta component takes light samples below the surface (its f is not zero
+// there; the others' f and densities are 0 below).
+bool shadeTransmits(ShadeMaterial m) {
+  return (COMPONENT_COUNT > 0u && componentTransmits(MODEL_0)) || (COMPONENT_COUNT > 1u && componentTransmits(MODEL_1)) ||
+         (COMPONENT_COUNT > 2u && componentTransmits(MODEL_2)) || (COMPONENT_COUNT > 3u && componentTransmits(MODEL_3));
+}
 
 // The sum of the non-delta components.
 vec3 shadeEval(ShadeMaterial m, vec3 wi, vec3 wo) {

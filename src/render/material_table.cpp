@@ -45,7 +45,19 @@ void tabulateComponentAlbedo(GpuComponent& c, bool maxChannel) {
     double cosTheta = std::max(double(n) / (COMPONENT_ALBEDO_NODES - 1), 0.02);
     double thetaDeg = std::acos(cosTheta) * 180.0 / M_PI;
     double a;
-    if (maxChannel) {
+    if (shared::modelTransmits(c.info.x) && !shared::modelIsDelta(c.info.x)) {
+      // A transmitting component scatters below the surface too: R + T (T with the BSDF's own
+      // radiance scaling, as the quadtree's lower disc holds it).
+      double rgb[3];
+      directionalAlbedoRgb(c.info.x, c.params, thetaDeg, 0.0, rgb);
+      const shared::vec3 wi(float(std::sin(thetaDeg * M_PI / 180.0)), 0.0f, float(cosTheta));
+      for (int k = 0; k < 3; ++k)
+        rgb[k] += hemisphereIntegral(
+            [&](shared::vec3 w) { return double(shared::brdfEval(c.info.x, c.params, wi, shared::vec3(w.x, w.y, -w.z))[k]); },
+            thetaDeg, 0.0, 1e-4);
+      a = maxChannel ? std::max(rgb[0], std::max(rgb[1], rgb[2]))
+                     : double(shared::luminance(shared::vec3(float(rgb[0]), float(rgb[1]), float(rgb[2]))));
+    } else if (maxChannel) {
       double rgb[3];
       directionalAlbedoRgb(c.info.x, c.params, thetaDeg, 0.0, rgb);
       a = std::max(rgb[0], std::max(rgb[1], rgb[2]));
@@ -72,22 +84,23 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     if (m.components.size() > MAX_COMPONENTS)
       throw Error("material " + m.name + ": " + std::to_string(m.components.size()) + " components, at most " +
                   std::to_string(MAX_COMPONENTS));
-    // A transmitting non-delta model (rough_dielectric) renders alone and with the quadtree
-    // sampler, whose transmitting sets cover both hemispheres (the shade stage continues paths
-    // and takes light samples below the surface, from either side). Refused rather than rendered
-    // as its reflection alone: as a component of a combined material (the component choice, its
-    // albedo tables and the MIS density cover the upper hemisphere only), and under the other
-    // strategies (they sample the upper hemisphere only). docs/models.md, "rough_dielectric".
-    for (const MaterialComponent& c : m.components)
-      if (shared::modelTransmits(c.model) && !modelById(c.model).delta)
-        throw Error("material " + m.name + ": model " + modelById(c.model).name +
-                    " as a component of a combined material is not rendered (rough transmission renders as a "
-                    "material of its own; docs/models.md)");
-    if (!m.combined() && shared::modelTransmits(m.model) && settings.sampler != SamplerKind::Quadtree)
-      throw Error("material " + m.name + ": model " + modelById(m.model).name +
-                  " transmits through a rough surface, which only the quadtree sampler samples (--sampler "
-                  "quadtree); the " + std::string(enumName(kSamplerNames, settings.sampler)) +
-                  " strategy samples the upper hemisphere only");
+    // A transmitting non-delta model (rough_dielectric), alone or as a component of a combined
+    // material, renders with the quadtree sampler, whose transmitting sets cover both hemispheres
+    // (the shade stage continues paths and takes light samples below the surface, from either
+    // side; a component's choice albedo counts R + T). Refused rather than rendered as its
+    // reflection alone under the other strategies (they sample the upper hemisphere only).
+    // docs/models.md, "rough_dielectric".
+    auto refuseRoughTransmission = [&](std::uint32_t model) {
+      if (shared::modelTransmits(model) && !modelById(model).delta && settings.sampler != SamplerKind::Quadtree)
+        throw Error("material " + m.name + ": model " + modelById(model).name +
+                    " transmits through a rough surface, which only the quadtree sampler samples (--sampler "
+                    "quadtree); the " + std::string(enumName(kSamplerNames, settings.sampler)) +
+                    " strategy samples the upper hemisphere only");
+    };
+    if (m.combined())
+      for (const MaterialComponent& c : m.components) refuseRoughTransmission(c.model);
+    else
+      refuseRoughTransmission(m.model);
     std::vector<std::uint32_t> key = slotKey(m);
     if (std::find(m_slotKeys.begin(), m_slotKeys.end(), key) == m_slotKeys.end()) m_slotKeys.push_back(key);
   }
@@ -108,6 +121,9 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     int component;  // -1: the material itself; kInsideUse: a transmitting material seen from the inside
   };
   constexpr int kInsideUse = -2;
+  // Component k of a combined material seen from the inside (a transmitting component's tables
+  // for transmissionInsideParams, GpuComponent.info.w).
+  auto insideComponentUse = [](std::size_t k) { return -3 - static_cast<int>(k); };
   std::vector<std::pair<std::uint32_t, shared::BrdfParams>> toBuild;
   std::vector<TableUse> uses;
   // Binned sampling: gltf_pbr materials whose textures vary their parameters share K sets of the
@@ -160,6 +176,11 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
         if (!modelById(m.components[k].model).delta && !(pbrVaries && m.components[k].model == MODEL_GLTF_PBR)) {
           toBuild.push_back({m.components[k].model, m.components[k].params});
           uses.push_back({static_cast<std::uint32_t>(i), static_cast<int>(k)});
+          if (shared::modelTransmits(m.components[k].model)) {
+            toBuild.push_back(
+                {m.components[k].model, shared::transmissionInsideParams(m.components[k].model, m.components[k].params)});
+            uses.push_back({static_cast<std::uint32_t>(i), insideComponentUse(k)});
+          }
         }
     }
   std::vector<std::uint32_t> setOf(toBuild.size(), INVALID_INDEX);
@@ -250,7 +271,10 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     for (std::size_t k = 0; k < src.components.size(); ++k) {
       const MaterialComponent& c = src.components[k];
       GpuComponent gc{};
-      gc.info = glm::uvec4(c.model, setFor(material, static_cast<int>(k)), binnedComponent(i, k) ? 1u : 0u, 0u);
+      gc.info = glm::uvec4(c.model, setFor(material, static_cast<int>(k)), binnedComponent(i, k) ? 1u : 0u,
+                           shared::modelTransmits(c.model) && !modelById(c.model).delta
+                               ? setFor(material, insideComponentUse(k))
+                               : INVALID_INDEX);
       gc.data = glm::vec4(c.weight, 0.0f, 0.0f, 0.0f);
       gc.params = c.params;
       // Every non-delta component gets its albedo table under the throughput roulette; under the

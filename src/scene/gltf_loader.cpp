@@ -1320,21 +1320,19 @@ class Converter {
     }
   }
 
-  // KHR_materials_transmission as smooth transmission (docs/scenes.md, "Transmission"): a combined
-  // material, gltf_pbr with weight 1 - w and a smooth dielectric of index ior (clamped to the
-  // model's [0.1, 10]) with weight w = transmissionFactor x (1 - metallic): the dielectric's
-  // Fresnel reflection and the gltf_pbr component's reflection together reflect as gltf_pbr
-  // alone, and the gltf_pbr diffuse lobe is scaled by 1 - w, as the extension's mix of diffuse and
-  // transmission does. w = 1: the dielectric alone. The dielectric refracts (`dielectric`) when
-  // KHR_materials_volume gives the mesh a thickness (thicknessFactor > 0); otherwise the surface is
-  // thin-walled, as the extension defines, and light passes straight through (`thin_dielectric`).
-  // Rough transmission: w = 1, no transmission texture and roughnessFactor r > 0 is
-  // `rough_dielectric` alone with a refracting volume (thicknessFactor > 0), `rough_thin_dielectric`
-  // alone when thin-walled; alpha = r^2 (clamped to the model's [0.001, 1]) and eta = ior (clamped
+  // KHR_materials_transmission (docs/scenes.md, "Transmission"): a combined material, gltf_pbr with
+  // weight 1 - w and a dielectric with weight w = transmissionFactor x (1 - metallic): the
+  // dielectric's Fresnel reflection and the gltf_pbr component's reflection together reflect as
+  // gltf_pbr alone, and the gltf_pbr diffuse lobe is scaled by 1 - w, as the extension's mix of
+  // diffuse and transmission does. w = 1 without a transmission texture: the dielectric alone. The
+  // dielectric refracts when KHR_materials_volume gives the mesh a thickness (thicknessFactor > 0);
+  // otherwise the surface is thin-walled, as the extension defines, and light passes straight
+  // through. Smooth (roughnessFactor 0): `dielectric` or `thin_dielectric` of index ior (clamped to
+  // the model's [0.1, 10]). Rough (roughnessFactor r > 0): `rough_dielectric` or
+  // `rough_thin_dielectric`, alpha = r^2 (clamped to the model's [0.001, 1]) and eta = ior (clamped
   // to its [1.01, 4], named in a warning when clamped); the microfacet roughness blurs reflection
-  // and transmission alike. Partial (w < 1) or textured rough transmission stays smooth, named in
-  // a warning (the renderer takes the rough models as materials of their own only:
-  // material_table.cpp).
+  // and transmission alike, alone or as the combination's transmitting component
+  // (material_table.cpp, shade_body.glsl).
   void transmissiveMaterial(Material& m, const std::string& context) {
     const float w = m.transmissionFactor * (1.0f - m.metallicFactor);
     if (!(w > 0.0f)) return;
@@ -1348,28 +1346,26 @@ class Converter {
     // shade_body.glsl) colours the transmitted light at every crossing of the surface.
     const ParamValue tint = arrayValue({ParamValue::num(m.baseColorFactor[0]), ParamValue::num(m.baseColorFactor[1]),
                                         ParamValue::num(m.baseColorFactor[2])});
-    if (r > 0.0f && w >= 1.0f && !textured) {
+    std::uint32_t glassModel = 0;
+    BrdfParams glass;
+    if (r > 0.0f) {
       const ModelSpec& rough = *findModel(thin ? "rough_thin_dielectric" : "rough_dielectric");
       const float eta = std::clamp(m.ior, 1.01f, 4.0f);
       if (eta != m.ior)
         warnOnce("KHR_materials_ior " + fmt(m.ior) + " of a rough transmitting material is rendered as " + fmt(eta) +
                  " (" + rough.name + "'s eta is in [1.01, 4])");
-      m.model = rough.id;
-      m.params = packParams(rough, {{"alpha", ParamValue::num(std::clamp(r * r, 0.001f, 1.0f))},
-                                    {"eta", ParamValue::num(eta)}, {"tint", tint}},
-                            context + " (rough transmission)");
-      return;
+      glassModel = rough.id;
+      glass = packParams(rough, {{"alpha", ParamValue::num(std::clamp(r * r, 0.001f, 1.0f))},
+                                 {"eta", ParamValue::num(eta)}, {"tint", tint}},
+                         context + " (rough transmission)");
+    } else {
+      const ModelSpec& smooth = *findModel(thin ? "thin_dielectric" : "dielectric");
+      glassModel = smooth.id;
+      glass = packParams(smooth, {{"eta", ParamValue::num(std::min(m.ior, 10.0f))}, {"tint", tint}},
+                         context + " (transmission)");
     }
-    if (r > 0.0f)
-      warnOnce(std::string("roughnessFactor > 0 of a transmitting material is rendered as smooth transmission when ") +
-               (textured ? "a transmissionTexture applies" : "transmissionFactor x (1 - metallic) < 1") +
-               " (rough transmission renders only as rough_dielectric or rough_thin_dielectric alone; docs/scenes.md, "
-               "\"Transmission\")");
-    const ModelSpec& glassModel = *findModel(thin ? "thin_dielectric" : "dielectric");
-    BrdfParams glass = packParams(glassModel, {{"eta", ParamValue::num(std::min(m.ior, 10.0f))}, {"tint", tint}},
-                                  context + " (transmission)");
     if (w >= 1.0f && !textured) {
-      m.model = glassModel.id;
+      m.model = glassModel;
       m.params = glass;
       return;
     }
@@ -1378,7 +1374,7 @@ class Converter {
     base.weight = std::max(0.0f, 1.0f - w);
     base.params = m.params;
     MaterialComponent clear;
-    clear.model = glassModel.id;
+    clear.model = glassModel;
     clear.weight = w;
     clear.params = glass;
     m.components = {base, clear};

@@ -925,6 +925,62 @@ TEST(RoughTransmission, LightBehindARoughInterfaceAgreesUnderNeeBsdfAndMis) {
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
+// Partial rough transmission: the combination {lambert rho 0.5, weight 1 - w; rough_dielectric
+// alpha 0.5, eta 1.5, weight w} (glTF's transmission with roughness and transmissionFactor w < 1,
+// or NUSSELT_brdf components). The lambert component reflects only light from above, and there is
+// none, so the lamp under the interface of emitterUnderRoughInterface shows through at w x the
+// rough interface's transmission (its quadrature, as above), under NEE (light samples below the
+// surface for the combination: shadeTransmits), BSDF sampling (the component's lower disc) and
+// MIS (the mixture's density below the surface). Then from the inside: the camera under the
+// interface looks up at a lamp above it (the back face: the component's inside parameters and
+// tables, GpuComponent.info.w), where the combination must give w x the rough interface alone
+// (Welch z of the two image means). z-tests at 0.001, Sidak over the 4 comparisons.
+TEST(RoughTransmission, PartialRoughTransmissionIsTheWeightedRoughInterface) {
+  const float alpha = 0.5f, eta = 1.5f, w = 0.4f;
+  Material partial = catalogueMaterial("lambert", {}, "partly frosted");
+  setComponents(partial, {catalogueComponent("lambert", {{"rho", ParamValue::num(0.5)}}, 1.0f - w),
+                          catalogueComponent("rough_dielectric", {{"alpha", ParamValue::num(alpha)}, {"eta", ParamValue::num(eta)}}, w)});
+  const double expected = w * roughInterfaceImage(alpha, eta, 8, 256);
+  const double allowance = 2 * w * std::fabs(roughInterfaceImage(alpha, eta, 8, 256) - roughInterfaceImage(alpha, eta, 4, 128));
+  const double zMax = test::normalQuantileUpper(0.5 * (1.0 - std::pow(1.0 - 0.001, 1.0 / 4.0)));
+  std::uint32_t seed = 61;
+  for (LightingMode mode : {LightingMode::NeeOnly, LightingMode::BsdfOnly, LightingMode::Mis}) {
+    RenderSettings rs = exactSettings(1, seed++, mode == LightingMode::NeeOnly ? 256 : 128);
+    rs.lighting = mode;
+    const test::Rendered r = test::render(emitterUnderRoughInterface(partial), rs);
+    EXPECT_EQ(r.stats.nonFiniteSamples, 0u);
+    const auto [mean, se] = imageMean(r.image);
+    std::printf("[ partial rough transmission ] %s: image %.5f +- %.5f, expected %.5f (allowance %.1e), z = %.2f\n",
+                lightingModeName(mode), mean, se, expected, allowance, (std::fabs(mean - expected) - allowance) / se);
+    EXPECT_LT(std::fabs(mean - expected), zMax * se + allowance) << lightingModeName(mode);
+  }
+  // From the inside: the interface's back face towards the camera, the lamp above facing down.
+  auto fromInside = [&](const Material& interface) {
+    Scene s;
+    s.materials.push_back(interface);
+    s.materials.push_back(catalogueMaterial("lambert", {{"rho", ParamValue::num(0.0)}}, "lamp", glm::vec3(1.0f)));
+    addTexturedQuad(s, 0.0f, 0, 3.0f);
+    addTexturedQuad(s, 1.0f, 1, kLampHalf, true);
+    s.hasCamera = true;
+    s.camera.orthographic = true;
+    s.camera.forward = glm::vec3(float(std::sin(kRoughTheta / 2)), 0.0f, float(std::cos(kRoughTheta / 2)));
+    s.camera.position = -3.0f * s.camera.forward;
+    s.camera.up = glm::vec3(0, 1, 0);
+    s.camera.xmag = s.camera.ymag = 0.25f;
+    RenderSettings rs = exactSettings(1, seed++, 128);
+    return test::render(s, rs);
+  };
+  const test::Rendered combined = fromInside(partial), alone = fromInside(roughGlass(alpha, eta));
+  const auto [mc, sc] = imageMean(combined.image);
+  const auto [ma, sa] = imageMean(alone.image);
+  const double z = (mc - w * ma) / std::hypot(sc, w * sa);
+  std::printf("[ partial rough transmission ] inside: combination %.5f +- %.5f, w x rough alone %.5f +- %.5f, z = %.2f\n",
+              mc, sc, w * ma, w * sa, z);
+  EXPECT_GT(ma, 0.05) << "the lamp does not show through the interface from the inside";
+  EXPECT_LT(std::fabs(z), zMax);
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
+
 // The smooth limit: at alpha 0.001 the rough interface of emitterUnderRoughInterface transmits
 // as the smooth dielectric, (1 - R) / eta^2 with R the unpolarised Fresnel reflectance at 30
 // degrees (the refracted ray meets the lamp from every point of the footprint); the same scene

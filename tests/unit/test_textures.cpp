@@ -518,11 +518,11 @@ TEST(GltfTextures, AlphaSidednessTransmissionIorVolume) {
   EXPECT_HAS(errorWith(R"({"normalTexture": {"index": 0, "scale": 1e300}})"), "normalTexture.scale");
 }
 
-// KHR_materials_transmission renders as smooth transmission: gltf_pbr with weight 1 - w plus a
-// dielectric of index ior with weight w = transmissionFactor x (1 - metallic); w = 1: the
-// dielectric alone. Neither extension is then named in the "not rendered" warning. With
-// KHR_materials_volume's thickness the dielectric refracts (dielectric); without, the surface is
-// thin-walled (thin_dielectric), as the extension defines.
+// KHR_materials_transmission renders as gltf_pbr with weight 1 - w plus a dielectric of index ior
+// with weight w = transmissionFactor x (1 - metallic); w = 1: the dielectric alone. Neither
+// extension is then named in the "not rendered" warning. With KHR_materials_volume's thickness the
+// dielectric refracts (dielectric; rough_dielectric with alpha = roughness^2 when the material is
+// rough); without, the surface is thin-walled (thin_dielectric), as the extension defines.
 TEST(GltfTextures, TransmissionBecomesTheDielectric) {
   Json j = texturedQuad();
   j["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"};
@@ -536,11 +536,13 @@ TEST(GltfTextures, TransmissionBecomesTheDielectric) {
   EXPECT_EQ(m.components[0].model, MODEL_GLTF_PBR);
   EXPECT_FLOAT_EQ(m.components[0].weight, 0.4f);
   EXPECT_FLOAT_EQ(m.components[0].params.v[GLTF_PBR_ROUGHNESS / 4][GLTF_PBR_ROUGHNESS % 4], 0.3f);
-  EXPECT_EQ(m.components[1].model, MODEL_DIELECTRIC);
+  // Rough (0.3) with a volume: rough_dielectric, alpha 0.09.
+  EXPECT_EQ(m.components[1].model, MODEL_ROUGH_DIELECTRIC);
   EXPECT_FLOAT_EQ(m.components[1].weight, 0.6f);
-  EXPECT_FLOAT_EQ(m.components[1].params.v[DIELECTRIC_ETA / 4][DIELECTRIC_ETA % 4], 1.33f);
+  EXPECT_FLOAT_EQ(m.components[1].params.v[ROUGH_DIELECTRIC_ETA / 4][ROUGH_DIELECTRIC_ETA % 4], 1.33f);
+  EXPECT_FLOAT_EQ(m.components[1].params.v[ROUGH_DIELECTRIC_ALPHA / 4][ROUGH_DIELECTRIC_ALPHA % 4], 0.09f);
   // The base colour (default white) tints the transmission.
-  EXPECT_EQ(shared::brdfParam3(m.components[1].params, DIELECTRIC_TINT), glm::vec3(1.0f));
+  EXPECT_EQ(shared::brdfParam3(m.components[1].params, ROUGH_DIELECTRIC_TINT), glm::vec3(1.0f));
   EXPECT_FALSE(hasWarning(s, "read but not rendered yet"));
   j["materials"][0] = Json::parse(R"({"name": "glass", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0,
     "baseColorFactor": [0.8, 0.5, 0.2, 1]},
@@ -603,19 +605,22 @@ TEST(GltfTextures, RoughTransmissionBecomesRoughDielectric) {
   // Smooth: the dielectric, as before.
   const Material g = material(R"(, "roughnessFactor": 0)", full + volume).materials[0];
   EXPECT_EQ(g.model, MODEL_DIELECTRIC);
-  // Partial rough transmission: the smooth combination, named.
+  // Partial rough transmission: the combination with rough_dielectric (weight w, alpha r^2), no warning.
   Scene p = material(R"(, "roughnessFactor": 0.5)", R"("KHR_materials_transmission": {"transmissionFactor": 0.5})" + volume);
   ASSERT_EQ(p.materials[0].components.size(), 2u);
-  EXPECT_EQ(p.materials[0].components[1].model, MODEL_DIELECTRIC);
-  EXPECT_TRUE(hasWarning(p, "roughnessFactor > 0 of a transmitting material is rendered as smooth transmission when "
-                            "transmissionFactor x (1 - metallic) < 1"));
+  EXPECT_EQ(p.materials[0].components[0].model, MODEL_GLTF_PBR);
+  EXPECT_FLOAT_EQ(p.materials[0].components[0].weight, 0.5f);
+  EXPECT_EQ(p.materials[0].components[1].model, MODEL_ROUGH_DIELECTRIC);
+  EXPECT_FLOAT_EQ(p.materials[0].components[1].weight, 0.5f);
+  EXPECT_FLOAT_EQ(p.materials[0].components[1].params.v[ROUGH_DIELECTRIC_ALPHA / 4][ROUGH_DIELECTRIC_ALPHA % 4], 0.25f);
+  EXPECT_FALSE(hasWarning(p, "rendered as smooth transmission"));
 }
 
 // Thin-walled rough transmission (no KHR_materials_volume, or thicknessFactor 0) with w = 1 and no
 // transmissionTexture: rough_thin_dielectric alone (issue 18), alpha = r^2, eta = ior (clamped to
 // the model's [1.01, 4], named), tint = baseColorFactor, no absorption and no warning. r = 0 stays
-// thin_dielectric; partial (w < 1) and textured rough transmission stay the smooth combination
-// with thin_dielectric, each named in the warning for exactly its case.
+// thin_dielectric; partial (w < 1) and textured rough transmission are the combination with
+// rough_thin_dielectric (the shade stage shades transmitting components on both sides).
 TEST(GltfTextures, ThinWalledRoughTransmissionBecomesRoughThinDielectric) {
   Json j = texturedQuad();
   j["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"};
@@ -647,21 +652,18 @@ TEST(GltfTextures, ThinWalledRoughTransmissionBecomesRoughThinDielectric) {
                             "(rough_thin_dielectric's eta is in [1.01, 4])"));
   // Smooth (r = 0): thin_dielectric, as before.
   EXPECT_EQ(material(R"(, "roughnessFactor": 0)", full).materials[0].model, MODEL_THIN_DIELECTRIC);
-  // Partial: the smooth combination with thin_dielectric, named as partial (not as textured).
+  // Partial and textured: the combination with rough_thin_dielectric (weight w, alpha r^2), no warning.
   Scene p = material(R"(, "roughnessFactor": 0.5)", R"("KHR_materials_transmission": {"transmissionFactor": 0.5})");
   ASSERT_EQ(p.materials[0].components.size(), 2u);
-  EXPECT_EQ(p.materials[0].components[1].model, MODEL_THIN_DIELECTRIC);
-  EXPECT_TRUE(hasWarning(p, "roughnessFactor > 0 of a transmitting material is rendered as smooth transmission when "
-                            "transmissionFactor x (1 - metallic) < 1 (rough transmission renders only as "
-                            "rough_dielectric or rough_thin_dielectric alone"));
-  EXPECT_FALSE(hasWarning(p, "transmissionTexture"));
-  // Textured (w = 1): the combination, named as textured (not as partial).
+  EXPECT_EQ(p.materials[0].components[1].model, MODEL_ROUGH_THIN_DIELECTRIC);
+  EXPECT_FLOAT_EQ(p.materials[0].components[1].weight, 0.5f);
+  EXPECT_FALSE(hasWarning(p, "rendered as smooth transmission"));
   Scene t = material(R"(, "roughnessFactor": 0.5)",
                      R"("KHR_materials_transmission": {"transmissionFactor": 1, "transmissionTexture": {"index": 0}})");
   ASSERT_EQ(t.materials[0].components.size(), 2u);
-  EXPECT_EQ(t.materials[0].components[1].model, MODEL_THIN_DIELECTRIC);
-  EXPECT_TRUE(hasWarning(t, "rendered as smooth transmission when a transmissionTexture applies"));
-  EXPECT_FALSE(hasWarning(t, "transmissionFactor x (1 - metallic) < 1"));
+  EXPECT_EQ(t.materials[0].components[1].model, MODEL_ROUGH_THIN_DIELECTRIC);
+  EXPECT_TRUE(t.materials[0].transmissionTextured);
+  EXPECT_FALSE(hasWarning(t, "rendered as smooth transmission"));
 }
 
 // transmissionTexture applies to the transmission combination: the material stays combined
