@@ -553,9 +553,10 @@ TEST(GltfTextures, TransmissionBecomesTheDielectric) {
   EXPECT_EQ(g.model, MODEL_DIELECTRIC);
   EXPECT_FLOAT_EQ(g.params.v[DIELECTRIC_ETA / 4][DIELECTRIC_ETA % 4], 1.5f);
   EXPECT_EQ(shared::brdfParam3(g.params, DIELECTRIC_TINT), glm::vec3(0.8f, 0.5f, 0.2f));
-  // Thin-walled: no volume, or a volume of thickness 0.
+  // Thin-walled: no volume, or a volume of thickness 0 (smooth: glTF's default roughness 1 would
+  // make it rough_thin_dielectric, ThinWalledRoughTransmissionBecomesRoughThinDielectric).
   for (const char* volume : {"", R"(, "KHR_materials_volume": {"thicknessFactor": 0})"}) {
-    j["materials"][0] = Json::parse(std::string(R"({"name": "pane", "pbrMetallicRoughness": {"metallicFactor": 0},
+    j["materials"][0] = Json::parse(std::string(R"({"name": "pane", "pbrMetallicRoughness": {"metallicFactor": 0, "roughnessFactor": 0},
       "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.5}, "KHR_materials_ior": {"ior": 1.7})") +
                                     volume + "}}");
     const Material t = loadJson(j).materials[0];
@@ -680,10 +681,10 @@ TEST(GltfTextures, TransmissionTextureKeepsTheCombination) {
   EXPECT_TRUE(m.transmissionTextured);
   EXPECT_EQ(m.components[0].model, MODEL_GLTF_PBR);
   EXPECT_FLOAT_EQ(m.components[0].weight, 0.0f);
-  EXPECT_EQ(m.components[1].model, MODEL_THIN_DIELECTRIC);
+  // glTF's default roughness 1: the rough sheet (ThinWalledRoughTransmissionBecomesRoughThinDielectric).
+  EXPECT_EQ(m.components[1].model, MODEL_ROUGH_THIN_DIELECTRIC);
   EXPECT_FLOAT_EQ(m.components[1].weight, 1.0f);
-  // (Applied, so not named as unrendered; glTF's default roughness 1 is named as rendered smooth
-  // because of the texture: ThinWalledRoughTransmissionBecomesRoughThinDielectric.)
+  // (Applied, so not named as unrendered.)
   EXPECT_FALSE(hasWarning(s, "not rendered yet: transmissionTexture"));
   j["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 1;
   Scene metal = loadJson(j);
