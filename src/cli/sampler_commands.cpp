@@ -32,6 +32,25 @@
 namespace nusselt {
 namespace {
 
+// Runs gpu(ctx) on a Vulkan context of device `device` (destroyed afterwards, also on an error)
+// and returns the device's name: the GPU side of `sample`'s strategies and of its binned mode.
+template <class F>
+std::string onDevice(int device, F&& gpu) {
+  vk::Context ctx;
+  vk::ContextOptions opts;
+  opts.deviceIndex = device;
+  vk::createContext(ctx, opts);
+  try {
+    gpu(ctx);
+  } catch (...) {
+    vk::destroyContext(ctx);
+    throw;
+  }
+  std::string name = ctx.deviceName;
+  vk::destroyContext(ctx);
+  return name;
+}
+
 using namespace shared;
 
 struct SampleArgs {
@@ -191,19 +210,10 @@ int sampleBinned(const SampleArgs& a, const ModelSpec& m, const BrdfParams& p, v
     b = quadtree::sampleCpu(tables, INVALID_INDEX, m.id, p, v, a.n, a.seed, 0, &B);
     where = "cpu";
   } else {
-    vk::Context ctx;
-    vk::ContextOptions opts;
-    opts.deviceIndex = a.device;
-    vk::createContext(ctx, opts);
-    try {
+    where = onDevice(a.device, [&](vk::Context& ctx) {
       b = quadtree::sampleGpu(ctx, tables, INVALID_INDEX, m.id, p, v, a.n, a.seed, SAMPLER_QUADTREE, nullptr, false, 0,
                               1u << 20, &B);
-    } catch (...) {
-      vk::destroyContext(ctx);
-      throw;
-    }
-    where = ctx.deviceName;
-    vk::destroyContext(ctx);
+    });
   }
   const std::uint64_t failed = writeSamplesCsv(a.output, b, a.n);
   std::printf("%s: %u samples (binned: %u bins spaced %g; roughness %g between bin %u (r = %g) and bin %u (r = %g), "
@@ -258,19 +268,10 @@ int sampleCommand(const SampleArgs& a) {
                                     a.n, a.seed);
     where = "cpu";
   } else {
-    vk::Context ctx;
-    vk::ContextOptions opts;
-    opts.deviceIndex = a.device;
-    vk::createContext(ctx, opts);
-    try {
+    where = onDevice(a.device, [&](vk::Context& ctx) {
       b = quadtree::sampleGpu(ctx, tables, setIndex[0], m.id, p, v, a.n, a.seed, strategy,
                              strategy == SAMPLER_TABULATED ? &tab : nullptr);
-    } catch (...) {
-      vk::destroyContext(ctx);
-      throw;
-    }
-    where = ctx.deviceName;
-    vk::destroyContext(ctx);
+    });
   }
   const std::uint64_t failed = writeSamplesCsv(a.output, b, a.n);
   if (strategy == SAMPLER_QUADTREE) {
