@@ -39,6 +39,17 @@ layout(constant_id = 3) const uint MODEL_0 = 0u;
 layout(constant_id = 4) const uint MODEL_1 = 0u;
 layout(constant_id = 5) const uint MODEL_2 = 0u;
 layout(constant_id = 6) const uint MODEL_3 = 0u;
+// A module built for materials of at most NUSSELT_COMBINED_SLOTS components (CMakeLists.txt:
+// shade_combined_c2_*) has no code for the slots above: lavapipe inlines every slot's calls (each
+// with every model) before it folds COMPONENT_COUNT, so the slots a material does not use cost
+// pipeline-creation time all the same (and glslang keeps a call under a constant-false condition:
+// only the preprocessor removes it).
+#ifndef NUSSELT_COMBINED_SLOTS
+#define NUSSELT_COMBINED_SLOTS 4
+#endif
+#if NUSSELT_COMBINED_SLOTS != 2 && NUSSELT_COMBINED_SLOTS != 4
+#error "NUSSELT_COMBINED_SLOTS: 2 or 4 (MAX_COMPONENTS)"
+#endif
 
 // ---- Combined materials: per-component terms (model = a specialization constant) ----
 // w_k f_k(wi, wo); 0 for delta components (never evaluated).
@@ -370,8 +381,12 @@ ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, Shade
   m.mode = combinedChoiceMode(g.componentChoice, roulette);
   if (COMPONENT_COUNT > 0u) m.C0 = g.components.v[first];
   if (COMPONENT_COUNT > 1u) m.C1 = g.components.v[first + 1u];
+#if NUSSELT_COMBINED_SLOTS > 2
   if (COMPONENT_COUNT > 2u) m.C2 = g.components.v[first + 2u];
+#endif
+#if NUSSELT_COMBINED_SLOTS > 3
   if (COMPONENT_COUNT > 3u) m.C3 = g.components.v[first + 3u];
+#endif
   float transmissionR = -1.0f;
   if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) {
     transmissionR = transmissionAt(hit.material, hit.tri, hit.b1, hit.b2);
@@ -380,14 +395,22 @@ ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, Shade
     materialTexels(hit.material, hit.tri, hit.b1, hit.b2, base, mr);
     if (COMPONENT_COUNT > 0u) texturedParams(MODEL_0, base, mr, m.C0.params);
     if (COMPONENT_COUNT > 1u) texturedParams(MODEL_1, base, mr, m.C1.params);
+#if NUSSELT_COMBINED_SLOTS > 2
     if (COMPONENT_COUNT > 2u) texturedParams(MODEL_2, base, mr, m.C2.params);
+#endif
+#if NUSSELT_COMBINED_SLOTS > 3
     if (COMPONENT_COUNT > 3u) texturedParams(MODEL_3, base, mr, m.C3.params);
+#endif
   }
   if (inside) {
     if (COMPONENT_COUNT > 0u) insideComponent(MODEL_0, m.C0);
     if (COMPONENT_COUNT > 1u) insideComponent(MODEL_1, m.C1);
+#if NUSSELT_COMBINED_SLOTS > 2
     if (COMPONENT_COUNT > 2u) insideComponent(MODEL_2, m.C2);
+#endif
+#if NUSSELT_COMBINED_SLOTS > 3
     if (COMPONENT_COUNT > 3u) insideComponent(MODEL_3, m.C3);
+#endif
   }
   // The transmission combination {gltf_pbr, 1 - w; glass, w} under a transmission texture: the
   // glass takes w R at this hit, gltf_pbr the rest (Material::transmissionTextured).
@@ -398,15 +421,23 @@ ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, Shade
   }
   if (COMPONENT_COUNT > 0u) m.a.x = componentChoiceWeight(m.mode, SAMPLER, MODEL_0, m.C0, wo);
   if (COMPONENT_COUNT > 1u) m.a.y = componentChoiceWeight(m.mode, SAMPLER, MODEL_1, m.C1, wo);
+#if NUSSELT_COMBINED_SLOTS > 2
   if (COMPONENT_COUNT > 2u) m.a.z = componentChoiceWeight(m.mode, SAMPLER, MODEL_2, m.C2, wo);
+#endif
+#if NUSSELT_COMBINED_SLOTS > 3
   if (COMPONENT_COUNT > 3u) m.a.w = componentChoiceWeight(m.mode, SAMPLER, MODEL_3, m.C3, wo);
+#endif
   vec4 P = combinedChoiceProbabilities(m.mode, COMPONENT_COUNT, m.a);
   m.c = combinedMisProbabilities(P);
   // Delta components take no light samples and have no MIS density: their c is dropped.
   if (modelIsDelta(MODEL_0)) m.c.x = 0.0f;
   if (modelIsDelta(MODEL_1)) m.c.y = 0.0f;
+#if NUSSELT_COMBINED_SLOTS > 2
   if (modelIsDelta(MODEL_2)) m.c.z = 0.0f;
+#endif
+#if NUSSELT_COMBINED_SLOTS > 3
   if (modelIsDelta(MODEL_3)) m.c.w = 0.0f;
+#endif
   m.lightSamples = (M.info.y & MATERIAL_DELTA) == 0u;
   return m;
 }
@@ -416,8 +447,12 @@ bool shadeLightSamples(ShadeMaterial m) { return m.lightSamples; }
 // A transmitting non-delta component takes light samples below the surface (its f is not zero
 // there; the others' f and densities are 0 below).
 bool shadeTransmits(ShadeMaterial m) {
+#if NUSSELT_COMBINED_SLOTS > 2
   return (COMPONENT_COUNT > 0u && componentTransmits(MODEL_0)) || (COMPONENT_COUNT > 1u && componentTransmits(MODEL_1)) ||
          (COMPONENT_COUNT > 2u && componentTransmits(MODEL_2)) || (COMPONENT_COUNT > 3u && componentTransmits(MODEL_3));
+#else
+  return (COMPONENT_COUNT > 0u && componentTransmits(MODEL_0)) || (COMPONENT_COUNT > 1u && componentTransmits(MODEL_1));
+#endif
 }
 
 // The sum of the non-delta components.
@@ -425,8 +460,12 @@ vec3 shadeEval(ShadeMaterial m, vec3 wi, vec3 wo) {
   vec3 f = vec3(0.0f);
   if (COMPONENT_COUNT > 0u) f += componentEval(MODEL_0, m.C0, wi, wo);
   if (COMPONENT_COUNT > 1u) f += componentEval(MODEL_1, m.C1, wi, wo);
+#if NUSSELT_COMBINED_SLOTS > 2
   if (COMPONENT_COUNT > 2u) f += componentEval(MODEL_2, m.C2, wi, wo);
+#endif
+#if NUSSELT_COMBINED_SLOTS > 3
   if (COMPONENT_COUNT > 3u) f += componentEval(MODEL_3, m.C3, wi, wo);
+#endif
   return f;
 }
 
@@ -434,8 +473,12 @@ float shadeMisPdf(ShadeMaterial m, vec3 wo, vec3 wi, vec3 wiWorld) {
   float pdf = 0.0f;
   if (COMPONENT_COUNT > 0u) pdf += componentMisPdf(MODEL_0, m.C0, m.c.x, wo, wi);
   if (COMPONENT_COUNT > 1u) pdf += componentMisPdf(MODEL_1, m.C1, m.c.y, wo, wi);
+#if NUSSELT_COMBINED_SLOTS > 2
   if (COMPONENT_COUNT > 2u) pdf += componentMisPdf(MODEL_2, m.C2, m.c.z, wo, wi);
+#endif
+#if NUSSELT_COMBINED_SLOTS > 3
   if (COMPONENT_COUNT > 3u) pdf += componentMisPdf(MODEL_3, m.C3, m.c.w, wo, wi);
+#endif
   return pdf;
 }
 
@@ -477,18 +520,22 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
     wk = m.C1.data.x;
     etaK = transmissionEtaScale(MODEL_1, m.C1.params, inside);
   }
+#if NUSSELT_COMBINED_SLOTS > 2
   if (COMPONENT_COUNT > 2u && j == 2u) {
     ok = componentSample(MODEL_2, m.C2, wo, inside, uB, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_2);
     wk = m.C2.data.x;
     etaK = transmissionEtaScale(MODEL_2, m.C2.params, inside);
   }
+#endif
+#if NUSSELT_COMBINED_SLOTS > 3
   if (COMPONENT_COUNT > 3u && j == 3u) {
     ok = componentSample(MODEL_3, m.C3, wo, inside, uB, wiLocal, weight, pdf, qk);
     delta = modelIsDelta(MODEL_3);
     wk = m.C3.data.x;
     etaK = transmissionEtaScale(MODEL_3, m.C3.params, inside);
   }
+#endif
   if (!ok || !(wk > 0.0f)) return false;
 
   float p = pk;

@@ -202,8 +202,10 @@ void PathIntegrator::createPipelines() {
           // texture and guiding code for the scenes and renders that use them.
           // Single-model materials under the quadtree strategy have a module per model,
           // shade_m<id>_s0 (CMakeLists.txt, SHADE_MODEL_SAMPLERS): ten times faster to create.
+          // Combined materials of one or two components: the module without slots 2 and 3
+          // (shade_combined_c2_sN: about half the creation time).
           const bool perModel = key[0] == 0 && sampler == SAMPLER_QUADTREE;
-          const std::string module = std::string(key[0] > 0 ? "shade_combined" : "shade") +
+          const std::string module = std::string(key[0] > 0 ? (key[0] <= 2 ? "shade_combined_c2" : "shade_combined") : "shade") +
                                      (perModel ? "_m" + std::to_string(key[1]) : std::string()) + "_s" +
                                      std::to_string(sampler) + (m_hasTextures || guiding || primary ? "_f" : "");
           m_shade[s] = vk::createComputePipeline(m_ctx, layout, module, spec);

@@ -380,12 +380,27 @@ void createContext(Context& ctx, const ContextOptions& options) {
   pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   pci.queueFamilyIndex = family;
   VK_CHECK(vkCreateCommandPool(ctx.device, &pci, nullptr, &ctx.commandPool));
+  ctx.pipelineStore.enabled = options.reusePipelines;
 }
 
 void destroyContext(Context& ctx) {
   if (ctx.device) {
     vkDeviceWaitIdle(ctx.device);
     if (ctx.commandPool) vkDestroyCommandPool(ctx.device, ctx.commandPool, nullptr);
+    {
+      PipelineStore& st = ctx.pipelineStore;
+      std::lock_guard<std::mutex> lock(st.mutex);
+      for (auto& [key, mp] : st.pipelines) {
+        vkDestroyPipeline(ctx.device, mp.second, nullptr);
+        vkDestroyShaderModule(ctx.device, mp.first, nullptr);
+      }
+      for (auto& [bytes, l] : st.layouts) {
+        vkDestroyPipelineLayout(ctx.device, l.second, nullptr);
+        vkDestroyDescriptorSetLayout(ctx.device, l.first, nullptr);
+      }
+      st.pipelines.clear();
+      st.layouts.clear();
+    }
     vkDestroyDevice(ctx.device, nullptr);
   }
   if (ctx.messenger) vkDestroyDebugUtilsMessengerEXT(ctx.instance, ctx.messenger, nullptr);
@@ -709,8 +724,9 @@ std::vector<std::uint32_t> embeddedShader(const std::string& name) {
   throw Error("internal: no embedded shader named \"" + name + "\"");
 }
 
-ComputePipeline createComputePipeline(Context& ctx, VkPipelineLayout layout, const std::string& shaderName,
-                                      const std::vector<std::uint32_t>& specialization) {
+namespace {
+ComputePipeline buildComputePipeline(Context& ctx, VkPipelineLayout layout, const std::string& shaderName,
+                                     const std::vector<std::uint32_t>& specialization) {
   ComputePipeline p;
   p.name = shaderName;
   std::vector<std::uint32_t> code = embeddedShader(shaderName);
@@ -732,32 +748,83 @@ ComputePipeline createComputePipeline(Context& ctx, VkPipelineLayout layout, con
   ci.stage.pName = "main";
   ci.stage.pSpecializationInfo = specialization.empty() ? nullptr : &spec;
   ci.layout = layout;
-  VK_CHECK(vkCreateComputePipelines(ctx.device, VK_NULL_HANDLE, 1, &ci, nullptr, &p.pipeline));
+  VkResult r = vkCreateComputePipelines(ctx.device, VK_NULL_HANDLE, 1, &ci, nullptr, &p.pipeline);
+  if (r != VK_SUCCESS) vkDestroyShaderModule(ctx.device, p.module, nullptr);
+  VK_CHECK(r);
   return p;
+}
+}  // namespace
+
+ComputePipeline createComputePipeline(Context& ctx, VkPipelineLayout layout, const std::string& shaderName,
+                                      const std::vector<std::uint32_t>& specialization) {
+  PipelineStore& st = ctx.pipelineStore;
+  bool keep = false;
+  if (st.enabled) {
+    std::lock_guard<std::mutex> lock(st.mutex);
+    for (const auto& [bytes, l] : st.layouts) keep = keep || l.second == layout;
+    if (keep) {
+      auto it = st.pipelines.find({layout, shaderName, specialization});
+      if (it != st.pipelines.end()) {
+        ++st.reused;
+        return ComputePipeline{shaderName, it->second.first, it->second.second, true};
+      }
+    }
+  }
+  // Created outside the lock (seconds for a large stage); a second thread asking for the same
+  // pipeline meanwhile builds its own and the first one stored wins.
+  ComputePipeline p = buildComputePipeline(ctx, layout, shaderName, specialization);
+  if (!keep) return p;
+  std::lock_guard<std::mutex> lock(st.mutex);
+  ++st.created;
+  auto [it, inserted] = st.pipelines.emplace(std::make_tuple(layout, shaderName, specialization), std::make_pair(p.module, p.pipeline));
+  if (!inserted) {
+    vkDestroyPipeline(ctx.device, p.pipeline, nullptr);
+    vkDestroyShaderModule(ctx.device, p.module, nullptr);
+  }
+  return ComputePipeline{shaderName, it->second.first, it->second.second, true};
 }
 
 void destroyComputePipeline(Context& ctx, ComputePipeline& p) {
-  if (p.pipeline) vkDestroyPipeline(ctx.device, p.pipeline, nullptr);
-  if (p.module) vkDestroyShaderModule(ctx.device, p.module, nullptr);
+  if (!p.kept) {
+    if (p.pipeline) vkDestroyPipeline(ctx.device, p.pipeline, nullptr);
+    if (p.module) vkDestroyShaderModule(ctx.device, p.module, nullptr);
+  }
   p.pipeline = VK_NULL_HANDLE;
   p.module = VK_NULL_HANDLE;
+  p.kept = false;
 }
 
 GlobalsBinding createGlobalsBinding(Context& ctx, VkBuffer globals, std::uint32_t pushBytes) {
   VkDevice d = ctx.device;
   GlobalsBinding b;
-  VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-  VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  sl.bindingCount = 1;
-  sl.pBindings = &binding;
-  VK_CHECK(vkCreateDescriptorSetLayout(d, &sl, nullptr, &b.setLayout));
-  VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushBytes};
-  VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  pl.setLayoutCount = 1;
-  pl.pSetLayouts = &b.setLayout;
-  pl.pushConstantRangeCount = 1;
-  pl.pPushConstantRanges = &range;
-  VK_CHECK(vkCreatePipelineLayout(d, &pl, nullptr, &b.layout));
+  PipelineStore& st = ctx.pipelineStore;
+  std::unique_lock<std::mutex> lock(st.mutex);
+  auto kept = st.enabled ? st.layouts.find(pushBytes) : st.layouts.end();
+  if (kept != st.layouts.end()) {
+    b.setLayout = kept->second.first;
+    b.layout = kept->second.second;
+    b.keptLayout = true;
+  } else {
+    VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+    VkDescriptorSetLayoutCreateInfo sl{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    sl.bindingCount = 1;
+    sl.pBindings = &binding;
+    VK_CHECK(vkCreateDescriptorSetLayout(d, &sl, nullptr, &b.setLayout));
+    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushBytes};
+    VkPipelineLayoutCreateInfo pl{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    pl.setLayoutCount = 1;
+    pl.pSetLayouts = &b.setLayout;
+    pl.pushConstantRangeCount = 1;
+    pl.pPushConstantRanges = &range;
+    VkResult r = vkCreatePipelineLayout(d, &pl, nullptr, &b.layout);
+    if (r != VK_SUCCESS) vkDestroyDescriptorSetLayout(d, b.setLayout, nullptr);
+    VK_CHECK(r);
+    if (st.enabled) {
+      st.layouts[pushBytes] = {b.setLayout, b.layout};
+      b.keptLayout = true;
+    }
+  }
+  lock.unlock();
   VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1};
   VkDescriptorPoolCreateInfo dp{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   dp.maxSets = 1;
@@ -782,8 +849,10 @@ GlobalsBinding createGlobalsBinding(Context& ctx, VkBuffer globals, std::uint32_
 
 void destroyGlobalsBinding(Context& ctx, GlobalsBinding& b) {
   if (b.pool) vkDestroyDescriptorPool(ctx.device, b.pool, nullptr);
-  if (b.layout) vkDestroyPipelineLayout(ctx.device, b.layout, nullptr);
-  if (b.setLayout) vkDestroyDescriptorSetLayout(ctx.device, b.setLayout, nullptr);
+  if (!b.keptLayout) {
+    if (b.layout) vkDestroyPipelineLayout(ctx.device, b.layout, nullptr);
+    if (b.setLayout) vkDestroyDescriptorSetLayout(ctx.device, b.setLayout, nullptr);
+  }
   b = GlobalsBinding{};
 }
 
