@@ -203,9 +203,14 @@ void PathIntegrator::createPipelines() {
           // Single-model materials under the quadtree strategy have a module per model,
           // shade_m<id>_s0 (CMakeLists.txt, SHADE_MODEL_SAMPLERS): ten times faster to create.
           // Combined materials of one or two components: the module without slots 2 and 3
-          // (shade_combined_c2_sN; a test rendering two such materials: 52 s to 44 s as a process).
+          // (shade_combined_c2_sN; a test rendering two such materials: 52 s to 44 s as a process),
+          // and when their models are all in models.h's lean list (glTF's, lambert, mirror), the
+          // one that dispatches over those alone (shade_combined_c2l_sN).
           const bool perModel = key[0] == 0 && sampler == SAMPLER_QUADTREE;
-          const std::string module = std::string(key[0] > 0 ? (key[0] <= 2 ? "shade_combined_c2" : "shade_combined") : "shade") +
+          bool lean = key[0] > 0 && key[0] <= 2;
+          for (std::uint32_t k = 0; lean && k < key[0]; ++k) lean = leanCombinationModel(key[1 + k]);
+          const std::string combined = lean ? "shade_combined_c2l" : key[0] <= 2 ? "shade_combined_c2" : "shade_combined";
+          const std::string module = std::string(key[0] > 0 ? combined : "shade") +
                                      (perModel ? "_m" + std::to_string(key[1]) : std::string()) + "_s" +
                                      std::to_string(sampler) + (m_hasTextures || guiding || primary ? "_f" : "");
           m_shade[s] = vk::createComputePipeline(m_ctx, layout, module, spec);

@@ -37,7 +37,8 @@
 #include "rough_thin_dielectric.h"
 
 // X(id, NAME, fn): MODEL_<NAME> = id; <NAME>_DELTA, <NAME>_ANALYTIC and the functions <fn>Eval,
-// <fn>Spec, ... come from the model's header.
+// <fn>Spec, ... come from the model's header. These are the only X(id, NAME, fn) lines of the file:
+// CMakeLists.txt (one shade module per model) and tests/cli/models.sh read them as the list.
 #define NUSSELT_MODELS(X)                  \
   X(0u, LAMBERT, lambert)                  \
   X(1u, PHONG_SPECULAR, phongSpecular)     \
@@ -70,9 +71,27 @@
 // constant that selects one, so a one-model module turns into a pipeline about 10x faster
 // (bench pipelines). The ids are defined for every model either way.
 #define NUSSELT_MODEL_APPLY(X, id, NAME, fn) X(id, NAME, fn)
+// The models of most combined materials: glTF's (gltf_loader.cpp: partial or textured
+// transmission is {gltf_pbr, 1 - w; a dielectric, w}) and the usual diffuse base and ideal lobe
+// (lambert, mirror). The combined shade modules built for them alone (shade_combined_c2l_sN,
+// -DNUSSELT_DISPATCH_LEAN=1; CMakeLists.txt) dispatch over these seven instead of all the models,
+// and lavapipe creates their pipelines that much faster. Each line is NUSSELT_MODEL_APPLY(X, ...)
+// with the arguments of the model's line in NUSSELT_MODELS (checked against it at compile time in
+// C++), not X(id, NAME, fn): CMakeLists.txt (SHADE_MODELS) and tests/cli/models.sh read every
+// X(id, NAME, fn) line of this file as a model of the list.
+#define NUSSELT_LEAN_COMBINATION_MODELS(X)                              \
+  NUSSELT_MODEL_APPLY(X, 0u, LAMBERT, lambert)                          \
+  NUSSELT_MODEL_APPLY(X, 17u, MIRROR, mirror)                           \
+  NUSSELT_MODEL_APPLY(X, 18u, DIELECTRIC, dielectric)                   \
+  NUSSELT_MODEL_APPLY(X, 19u, GLTF_PBR, gltfPbr)                        \
+  NUSSELT_MODEL_APPLY(X, 21u, THIN_DIELECTRIC, thinDielectric)          \
+  NUSSELT_MODEL_APPLY(X, 22u, ROUGH_DIELECTRIC, roughDielectric)        \
+  NUSSELT_MODEL_APPLY(X, 23u, ROUGH_THIN_DIELECTRIC, roughThinDielectric)
 #ifdef NUSSELT_SHADE_MODEL_ID
 #define NUSSELT_DISPATCH_MODELS(X) \
   NUSSELT_MODEL_APPLY(X, NUSSELT_SHADE_MODEL_ID, NUSSELT_SHADE_MODEL_NAME, NUSSELT_SHADE_MODEL_FN)
+#elif defined(NUSSELT_DISPATCH_LEAN)
+#define NUSSELT_DISPATCH_MODELS(X) NUSSELT_LEAN_COMBINATION_MODELS(X)
 #else
 #define NUSSELT_DISPATCH_MODELS(X) NUSSELT_MODELS(X)
 #endif
@@ -105,7 +124,20 @@ constexpr bool idsArePositions() {
   return true;
 }
 static_assert(idsArePositions(), "models.h: model ids must be 0, 1, 2, ... in list order");
+#define NUSSELT_LEAN_MODEL_CHECK(id, NAME, fn) static_assert(MODEL_##NAME == id, "models.h: NUSSELT_LEAN_COMBINATION_MODELS: " #NAME "'s id");
+NUSSELT_LEAN_COMBINATION_MODELS(NUSSELT_LEAN_MODEL_CHECK)
+#undef NUSSELT_LEAN_MODEL_CHECK
 }  // namespace nusselt::shared::model_list_check
+namespace nusselt {
+// Whether `model` is one of NUSSELT_LEAN_COMBINATION_MODELS (the combined shade module built for
+// them alone serves combinations of these only).
+inline bool leanCombinationModel(shared::uint model) {
+#define NUSSELT_LEAN_MODEL_IS(id, NAME, fn) if (model == id) return true;
+  NUSSELT_LEAN_COMBINATION_MODELS(NUSSELT_LEAN_MODEL_IS)
+#undef NUSSELT_LEAN_MODEL_IS
+  return false;
+}
+}  // namespace nusselt
 #endif
 
 #endif
