@@ -369,7 +369,7 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
 }
 
 bool constantInSampledDirection(std::uint32_t model, const BrdfParams& params) {
-  if (model >= MODEL_COUNT || modelIsDelta(model) || modelTransmits(model) || model == MODEL_MERL) return false;
+  if (model >= MODEL_COUNT || modelIsDelta(model) || modelTransmits(model)) return false;
   // Known directions: polar angles 0 .. 89 degrees, azimuths spread by the golden angle (anisotropic
   // models see several); sampled directions: a 32 x 32 grid of (cos theta, phi) cell centres, whose
   // cos theta reaches 1 / 64 (89.1 degrees).
