@@ -271,6 +271,10 @@ int renderCommand(const RenderArgs& a) {
         std::fprintf(stderr, "sampler: %u quadtrees (%.1f MiB) in %.2f s (cache: %u hits, %u built, %u rejected)\n",
                      sum.samplerTrees, sum.samplerBytes / 1048576.0, sum.samplerSeconds, sum.samplerCacheHits,
                      sum.samplerCacheMisses, sum.samplerCacheRejected);
+      if (sum.constantBrdfs)
+        std::fprintf(stderr, "sampler: %u material%s or component%s with a constant BRDF (lambert) sampled by cosine, "
+                             "the exact sampler its quadtree would be\n",
+                     sum.constantBrdfs, sum.constantBrdfs == 1 ? "" : "s", sum.constantBrdfs == 1 ? "" : "s");
       if (sum.roughnessBins)
         std::fprintf(stderr, "sampler: textured gltf_pbr sampled with %u roughness bins (spacing %g, %.1f MiB of the trees)\n",
                      sum.roughnessBins, s.roughnessBinSpacing, sum.binBytes / 1048576.0);

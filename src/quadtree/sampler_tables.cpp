@@ -368,6 +368,33 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
   return out;
 }
 
+bool constantInSampledDirection(std::uint32_t model, const BrdfParams& params) {
+  if (model >= MODEL_COUNT || modelIsDelta(model) || modelTransmits(model)) return false;
+  // Known directions: polar angles 0 .. 89 degrees, azimuths spread by the golden angle (anisotropic
+  // models see several); sampled directions: a 32 x 32 grid of (cos theta, phi) cell centres, whose
+  // cos theta reaches 1 / 64 (89.1 degrees).
+  for (int i = 0; i < 32; ++i) {
+    const double tv = (M_PI / 180) * (89.0 * i / 31.0), pv = 2.399963229728653 * i;
+    const vec3 v(float(std::sin(tv) * std::cos(pv)), float(std::sin(tv) * std::sin(pv)), float(std::cos(tv)));
+    bool first = true;
+    vec3 f0(0.0f);
+    for (int a = 0; a < 32; ++a)
+      for (int b = 0; b < 32; ++b) {
+        const double c = (a + 0.5) / 32.0, s = std::sqrt(1.0 - c * c), pw = 2 * M_PI * (b + 0.5) / 32.0;
+        const vec3 w(float(s * std::cos(pw)), float(s * std::sin(pw)), float(c));
+        const vec3 f = brdfEval(model, params, w, v);
+        if (!std::isfinite(f.x) || !std::isfinite(f.y) || !std::isfinite(f.z)) return false;
+        if (first) {
+          f0 = f;
+          first = false;
+        } else if (!(f.x == f0.x && f.y == f0.y && f.z == f0.z)) {
+          return false;
+        }
+      }
+  }
+  return true;
+}
+
 QuadHostScope::QuadHostScope(const SamplerTables& t) {
   m_host.sets = t.sets.data();
   m_host.tables = t.tables.data();

@@ -54,6 +54,16 @@ struct SamplerTables {
 SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, shared::BrdfParams>>& materials,
                                  const QuadtreeSettings& settings, std::vector<std::uint32_t>& setIndexPerMaterial);
 
+// Whether f(w, v) of a non-delta, non-transmitting model is the same rgb value for every sampled
+// direction w at each known direction v, on a probe of 32 known directions x 1024 sampled ones
+// (polar angles up to 89.1 degrees, azimuths over the whole circle): lambert, oren_nayar with
+// sigma = 0, a measured (merl) table of one constant value. The quadtree of such a BRDF is the uniform density on the unit disc,
+// which cosine-weighted hemisphere sampling draws exactly with no tree, no rejection and no table
+// look-up (the Nusselt analog), so renders give such materials no tables and sample them by cosine
+// (docs/sampler.md, "Constant BRDFs"). A model that passed the probe but varied elsewhere would
+// still be sampled without bias (cosine sampling with its own pdf), only less closely to f cos.
+bool constantInSampledDirection(std::uint32_t model, const shared::BrdfParams& params);
+
 // The cache directory in use ("" when none is writable).
 std::string cacheDirectory();
 

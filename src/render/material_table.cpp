@@ -152,6 +152,14 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     toBuild = quadtree::roughnessBinMaterials(m_bins);
     for (std::uint32_t j = 0; j < settings.roughnessBins; ++j) uses.push_back({INVALID_INDEX, static_cast<int>(j)});
   }
+  // A BRDF that does not depend on the sampled direction (lambert): its quadtree would be the
+  // uniform disc, which cosine sampling draws exactly and faster, so the quadtree gives it no
+  // table (INVALID_INDEX: effectiveSampler takes cosine; constantInSampledDirection).
+  auto constantBrdf = [&](std::uint32_t model, const shared::BrdfParams& params) {
+    if (settings.sampler != SamplerKind::Quadtree || !quadtree::constantInSampledDirection(model, params)) return false;
+    ++m_plan.constantBrdfs;
+    return true;
+  };
   if (settings.sampler == SamplerKind::Quadtree || settings.sampler == SamplerKind::Tabulated)
     for (std::size_t i = 0; i < scene.materials.size(); ++i) {
       if (!used[i]) continue;
@@ -159,7 +167,8 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
       // A texture that varies the BRDF's parameters over the surface: no one table fits
       // (INVALID_INDEX): gltf_pbr under the quadtree samples the roughness bins above
       // (MATERIAL_BINNED), the rest falls back to cosine (docs/scenes.md, "Sampling textured materials").
-      if (!m.combined() && !modelById(m.model).delta && !textureUse(m, scene).paramsVary()) {
+      if (!m.combined() && !modelById(m.model).delta && !textureUse(m, scene).paramsVary() &&
+          !constantBrdf(m.model, m.params)) {
         toBuild.push_back({m.model, m.params});
         uses.push_back({static_cast<std::uint32_t>(i), -1});
         // A transmitting model's tables for the inside too (its parameters seen from there,
@@ -173,7 +182,8 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
       // quadtree, else cosine (MaterialTextureUse::paramsVary).
       const bool pbrVaries = textureUse(m, scene).paramsVary();
       for (std::size_t k = 0; k < m.components.size(); ++k)
-        if (!modelById(m.components[k].model).delta && !(pbrVaries && m.components[k].model == MODEL_GLTF_PBR)) {
+        if (!modelById(m.components[k].model).delta && !(pbrVaries && m.components[k].model == MODEL_GLTF_PBR) &&
+            !constantBrdf(m.components[k].model, m.components[k].params)) {
           toBuild.push_back({m.components[k].model, m.components[k].params});
           uses.push_back({static_cast<std::uint32_t>(i), static_cast<int>(k)});
           if (shared::modelTransmits(m.components[k].model)) {

@@ -30,6 +30,10 @@ struct SamplerPlanSummary {
   // that needs them, or no bins) and their sets' bytes (included in bytes).
   std::uint32_t roughnessBins = 0;
   std::uint64_t binBytes = 0;
+  // Materials and components whose BRDF does not depend on the sampled direction (lambert): under
+  // the quadtree they get no table and are sampled by cosine, the uniform disc their tree would be
+  // (quadtree::constantInSampledDirection).
+  std::uint32_t constantBrdfs = 0;
 };
 
 class MaterialTable {

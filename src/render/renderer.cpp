@@ -156,6 +156,7 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   m_summary.samplerCacheRejected = plan.cacheRejected;
   m_summary.roughnessBins = plan.roughnessBins;
   m_summary.binBytes = plan.binBytes;
+  m_summary.constantBrdfs = plan.constantBrdfs;
   m_film = std::make_unique<Film>(m_ctx, settings.width, settings.height);
 
   Globals& g = m_globals->host();

@@ -39,6 +39,7 @@ struct SceneSummary {
   std::uint32_t samplerCacheHits = 0, samplerCacheMisses = 0, samplerCacheRejected = 0;
   std::uint32_t roughnessBins = 0;  // binned sampling's bins (0: none built), their bytes in binBytes
   std::uint64_t binBytes = 0;
+  std::uint32_t constantBrdfs = 0;  // materials and components sampled by cosine, their exact sampler (SamplerPlanSummary)
   std::uint64_t deviceBytes = 0;
   bool guiding = false;             // path guiding (docs/guiding.md)
   std::uint32_t guideTrainSpp = 0;  // its training samples per pixel

@@ -6,6 +6,8 @@
 // comparison (test_mis.cpp's test), fixed seeds; thresholds come from the statistics, never tuned.
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include "../support/test_support.h"
 #include "brdf/registry.h"
 
@@ -58,4 +60,30 @@ TEST(StrategiesRender, TabulatedAnalyticCosineQuadtreeAgree) { expectStrategiesA
 
 TEST(StrategiesRender, CombinedMaterialAgrees) {
   expectStrategiesAgree(glossyScene({component("lambert", 0.5f), component("phong", 0.5f)}));
+}
+
+// A BRDF that does not depend on the sampled direction (lambert) gets no quadtree: its tree would
+// be the uniform disc, which cosine sampling draws exactly (quadtree::constantInSampledDirection).
+// So the quadtree's render of a lambert floor is the cosine render, bit for bit, with the same
+// seed; and the summary counts the material.
+TEST(StrategiesRender, ConstantBrdfUnderTheQuadtreeIsCosineSampled) {
+  Scene scene = glossyScene({component("lambert", 1.0f)});
+  RenderSettings s;
+  s.width = 16;
+  s.height = 16;
+  s.spp = 8;
+  s.maxDepth = 3;
+  s.seed = 5;
+  s.sampler = SamplerKind::Quadtree;
+  test::Rendered quad = test::render(scene, s);
+  s.sampler = SamplerKind::Cosine;
+  test::Rendered cosine = test::render(scene, s);
+  EXPECT_GE(quad.summary.constantBrdfs, 1u);
+  EXPECT_EQ(cosine.summary.constantBrdfs, 0u);
+  ASSERT_EQ(quad.image.rgb.size(), cosine.image.rgb.size());
+  double sum = 0;
+  for (float v : quad.image.rgb) sum += v;
+  EXPECT_GT(sum, 0.0);  // not black
+  EXPECT_EQ(std::memcmp(quad.image.rgb.data(), cosine.image.rgb.data(), quad.image.rgb.size() * sizeof(float)), 0);
+  EXPECT_EQ(test::validationMessages(), 0u);
 }
