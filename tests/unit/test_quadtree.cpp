@@ -75,6 +75,8 @@ TEST(Quadtree, TreeTotalsMatchDirectionalAlbedo) {
 // Gauss points once lost 9 % of the albedo at theta 40, phi 67.5 while every phi = 0 angle above
 // passed. Threshold 5e-4: the worst of this grid is 1.9e-4 (ashikhmin_shirley hard, theta 85,
 // phi 22.5; an independent 8000 x 32000 midpoint rule agrees with directionalAlbedo to 4e-8).
+// Normal incidence has no azimuth: one case (its five azimuths built the same tree, v = (0, 0, 1)
+// exactly, and compared it with five quadratures of the same integral: 36 cases per set, not 40).
 TEST(Quadtree, AnisotropicTreeTotalsOverIncidentAzimuth) {
   double worst = 0;
   std::string worstName;
@@ -86,6 +88,7 @@ TEST(Quadtree, AnisotropicTreeTotalsOverIncidentAzimuth) {
       if (!quadtree::modelTraits(m.id, p).anisotropic) continue;
       for (double t : {0.0, 15.0, 25.0, 40.0, 55.0, 70.0, 80.0, 85.0})
         for (double ph : {0.0, 22.5, 45.0, 67.5, 90.0}) {
+          if (t == 0.0 && ph != 0.0) continue;
           double th = t * M_PI / 180, pr = ph * M_PI / 180;
           vec3 v(float(std::sin(th) * std::cos(pr)), float(std::sin(th) * std::sin(pr)), float(std::cos(th)));
           quadtree::Tree tree = quadtree::buildTree(m.id, p, v, {});
