@@ -1,7 +1,7 @@
 // test_primary_samples.cpp: a sampled direction is a function of the primary numbers the sampler
 // receives (issue 15 step 5, for Metropolis, issue 19): the quadtree's rejection trials and its
 // descent's fresh numbers come from the stream of u (rng.h, rngStreamKey), not from the pixel or
-// sample that produced u. The GPU side: QuadtreeGpu.ChiSquareAndParity compares the GPU tool's
+// sample that produced u. The GPU side: QuadtreeGpu.ChiSquareCpuGpuAndParity compares the GPU tool's
 // samples with this CPU code, which sees u only.
 #include <gtest/gtest.h>
 

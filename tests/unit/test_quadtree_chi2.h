@@ -1,6 +1,6 @@
 // test_quadtree_chi2.h: chi-square goodness of fit of sampled directions against a pdf (as
-// Mitsuba 3 tests its BSDFs), shared by the quadtree tests (tests/unit/test_quadtree.cpp, CPU;
-// tests/gpu/test_quadtree_gpu.cpp, GPU) and the other strategies' (tests/unit/test_strategies.cpp).
+// Mitsuba 3 tests its BSDFs), shared by the quadtree tests (tests/gpu/test_quadtree_gpu.cpp, CPU
+// and GPU samples; tests/unit/test_quadtree.cpp) and the other strategies' (tests/unit/test_strategies.cpp).
 //
 // Bins: rings in c = cos theta times sectors in phi. Either fixed (equal-area rings, equal sectors)
 // or equal-probability bins from an independent pilot sample (quantiles of c, then of phi within
@@ -383,14 +383,27 @@ inline Chi2Result chiSquare(const Binning& bins, const std::vector<double>& prob
   return r;
 }
 
-// The quadtree sampler's test for one case: pilot bins from `pilot`, expected counts from quadPdf.
+// The quadtree sampler's bins for one case: pilot bins from `pilot`, their probabilities from
+// quadPdf (the quadrature), for as many sample batches of the case as are tested
+// (QuadtreeGpu.ChiSquareCpuGpuAndParity tests the CPU's and the GPU's against one set).
 // Transmitting models: bins over the sphere (both discs, each with its share of the samples).
+struct QuadBins {
+  Binning bins;
+  std::vector<double> prob;
+};
+inline QuadBins quadBins(const quadtree::SamplerTables& t, std::uint32_t set, std::uint32_t model, const BrdfParams& p, vec3 v,
+                         const std::vector<vec4>& pilot) {
+  QuadBins b;
+  b.bins = quantileBinning(pilot, 16, 32, modelById(model).transmits);
+  b.prob = binProbabilities([&](vec3 w) { return double(quadPdf(set, model, p, v, w)); }, b.bins, pilot,
+                            [&]() { return std::make_shared<quadtree::QuadHostScope>(t); });
+  return b;
+}
+inline Chi2Result quadChiSquare(const QuadBins& b, const std::vector<vec4>& samples) { return chiSquare(b.bins, b.prob, samples); }
+// The same for one batch of samples.
 inline Chi2Result quadChiSquare(const quadtree::SamplerTables& t, std::uint32_t set, std::uint32_t model, const BrdfParams& p,
                                 vec3 v, const std::vector<vec4>& pilot, const std::vector<vec4>& samples) {
-  Binning bins = quantileBinning(pilot, 16, 32, modelById(model).transmits);
-  std::vector<double> prob = binProbabilities([&](vec3 w) { return double(quadPdf(set, model, p, v, w)); }, bins, pilot,
-                                              [&]() { return std::make_shared<quadtree::QuadHostScope>(t); });
-  return chiSquare(bins, prob, samples);
+  return quadChiSquare(quadBins(t, set, model, p, v, pilot), samples);
 }
 
 // Sampler tables of one material at a time (testSettings), built on first use: the case

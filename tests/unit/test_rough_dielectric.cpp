@@ -317,7 +317,7 @@ TEST(RoughDielectric, LowerDiscTreeTotalsAndEnvelopes) {
 // significance 0.01 with Bonferroni over the 10 cases; the share of samples below the surface
 // against the tables' a_low / (a_up + a_low) (on tables; z-test, |z| < 5); the pdf integrates to 1
 // over the sphere; on tables every weight f |cos| / pdf is a_up + a_low (2e-3); no bound
-// violations, no trial failures. (Quadtree.ChiSquareCpu runs these cases too, within its matrix.)
+// violations, no trial failures. (QuadtreeGpu.ChiSquareCpuGpuAndParity runs these cases too, within its matrix.)
 // Then the same test must reject a broken sampler: the tables' lower masses halved, which halves
 // the probability of the lower disc while its trees (and so the density within it) stay as they
 // are; its pdf claims f |cos| / (a_up + a_low / 2) (a sampler that can fail). The typical set seen
