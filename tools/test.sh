@@ -20,4 +20,10 @@ if [ "${SKIP_FUZZ:-0}" != 1 ]; then
 fi
 # Last, so that its summary ("100% tests passed, 0 tests failed out of N") closes the output.
 echo "== main suite (ctest)"
+# ctest starts the longest tests first when it knows their times (its cost file, written by every
+# run). A fresh build has none, and then the longest test (the quadtree chi-square, ~1000 s) may
+# start last and run alone at the end: seed the file with the times of the tests that take 5 s or
+# more (tools/ctest-costs.txt, from a fresh-clone run of this script; only the order depends on it).
+mkdir -p build/Testing/Temporary
+[ -s build/Testing/Temporary/CTestCostData.txt ] || cp tools/ctest-costs.txt build/Testing/Temporary/CTestCostData.txt
 ctest --test-dir build --output-on-failure -j "$(nproc)"
