@@ -229,10 +229,7 @@ int renderCommand(const RenderArgs& a) {
   vk::createContext(ctx, co);
   int status = kExitOk;
   {
-    if (!a.quiet && s.sampler == SamplerKind::Quadtree)
-      std::fprintf(stderr, "sampler: building or loading the quadtrees of the scene's materials (cached in %s; "
-                           "a first build can take minutes for some models, see docs/sampler.md)\n",
-                   quadtree::cacheDirectory().empty() ? "no writable directory" : quadtree::cacheDirectory().c_str());
+    if (!a.quiet) s.notice = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
     Renderer renderer(ctx, scene, s);
     renderer.setCamera(base.camera);
     const SceneSummary& sum = renderer.summary();

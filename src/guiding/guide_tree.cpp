@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <thread>
+#include <utility>
+#include <vector>
 
 namespace nusselt::guiding {
 
@@ -178,14 +181,20 @@ void GuideTree::splatDirection(std::uint32_t leafIndex, glm::vec3 d, double valu
   else t.splat(p, value);
 }
 
+void GuideTree::splatInLeaf(std::uint32_t leafIndex, glm::vec3 d, double value, double count) {
+  m_leaves[leafIndex].samples += count;
+  if (value > 0 && std::isfinite(value)) splatDirection(leafIndex, d, value);
+}
+
 void GuideTree::splatAt(std::uint32_t leafIndex, glm::vec3 x, glm::vec3 d, double value, double count) {
+  if (splatsStayInTheirLeaf()) {
+    splatInLeaf(leafIndex, d, value, count);
+    ++m_splats;
+    return;
+  }
   m_leaves[leafIndex].samples += count;
   ++m_splats;
   if (!(value > 0) || !std::isfinite(value)) return;
-  if (!m_settings.spatialFilter || m_leaves.size() == 1) {
-    splatDirection(leafIndex, d, value);
-    return;
-  }
   // The box of x's region's size around x, within the root box.
   const SpatialNode& home = m_nodes[findNode(x)];
   const glm::dvec3 half = 0.5 * (glm::dvec3(home.hi) - glm::dvec3(home.lo));
@@ -405,31 +414,90 @@ void GuideTree::flatten(std::vector<shared::GuideSpatialNode>& spatial, std::vec
 // ---- Training records -----------------------------------------------------------------------------
 
 std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_t recordsPerPath,
-                         const glm::vec4* pathRadiance, std::uint32_t paths) {
+                         const glm::vec4* pathRadiance, std::uint32_t paths, unsigned threads) {
   constexpr std::uint32_t R = GUIDE_RECORD_VEC4S;
-  std::uint64_t splats = 0;
   if (recordsPerPath < 2) return 0;
-  for (std::uint32_t p = 0; p < paths; ++p) {
-    const glm::vec4 L = pathRadiance[p];
-    const double lEnd = shared::luminance(shared::vec3(L.x, L.y, L.z));
-    if (!std::isfinite(lEnd)) continue;  // dropped from the film too
-    const glm::vec4* r = records + std::size_t(p) * recordsPerPath * R;
-    for (std::uint32_t k = 0; k + 1 < recordsPerPath; ++k) {
-      const glm::vec4 a = r[R * k], b = r[R * k + 1], c = r[R * k + 2];
-      if (b.w == 0.0f) break;  // the path ended at vertex k
-      if (!(b.w > 0.0f)) continue;  // a delta sample: the path goes on, nothing to splat
-      const float arrived = r[R * (k + 1)].w;
-      // What reached vertex k through its sample: everything the path gathered from vertex k + 1's
-      // arrival on; nothing when that ray left a scene without environment (-1).
-      const double after = arrived < 0.0f ? 0.0 : std::max(0.0, lEnd - double(arrived));
+  const std::uint32_t perPath = recordsPerPath - 1;  // splat slots per path: vertices 0 .. recordsPerPath - 2
+  // Calls fn(p, k, x, d, sample record, arrived-after radiance) for every splat of paths [p0, p1), in order.
+  auto forEachSplat = [&](std::uint32_t p0, std::uint32_t p1, auto&& fn) {
+    for (std::uint32_t p = p0; p < p1; ++p) {
+      const glm::vec4 L = pathRadiance[p];
+      const double lEnd = shared::luminance(shared::vec3(L.x, L.y, L.z));
+      if (!std::isfinite(lEnd)) continue;  // dropped from the film too
+      const glm::vec4* r = records + std::size_t(p) * recordsPerPath * R;
+      for (std::uint32_t k = 0; k < perPath; ++k) {
+        const glm::vec4 b = r[R * k + 1];
+        if (b.w == 0.0f) break;       // the path ended at vertex k
+        if (!(b.w > 0.0f)) continue;  // a delta sample: the path goes on, nothing to splat
+        const float arrived = r[R * (k + 1)].w;
+        // What reached vertex k through its sample: everything the path gathered from vertex k + 1's
+        // arrival on; nothing when that ray left a scene without environment (-1).
+        const double after = arrived < 0.0f ? 0.0 : std::max(0.0, lEnd - double(arrived));
+        fn(p, k, r[R * k], b, r[R * k + 2], after);
+      }
+    }
+  };
+  unsigned t = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
+  t = std::min<unsigned>(t, tree.leafCount());
+  if (t < 2 || !tree.splatsStayInTheirLeaf() || paths < 4096u) {
+    std::uint64_t splats = 0;
+    forEachSplat(0, paths, [&](std::uint32_t, std::uint32_t, glm::vec4 a, glm::vec4 b, glm::vec4 c, double after) {
       const std::uint32_t leaf = tree.findLeaf(glm::vec3(a));
       tree.splatAt(leaf, glm::vec3(a), glm::vec3(b), after / double(b.w));
       // The same radiance is the vertex's estimate through its sample (y = F / p_mix).
       if (c.x >= 0.0f) tree.observeSelection(leaf, after, c.x, c.y, c.z);
       ++splats;
-    }
+    });
+    return splats;
   }
-  return splats;
+  // In parallel, the same operations per leaf in the same order: 1. every splat's leaf (threads
+  // over path ranges; findLeaf only reads), with the splats per leaf; 2. the leaves shared among
+  // the threads by their splats (largest first, to the least loaded; a fixed rule); 3. each thread
+  // walks all paths in order and applies the splats of its own leaves.
+  std::vector<std::uint32_t> leafOf(std::size_t(paths) * perPath);
+  std::vector<std::vector<std::uint64_t>> counts(t, std::vector<std::uint64_t>(tree.leafCount(), 0));
+  auto run = [&](auto&& body) {
+    std::vector<std::thread> pool;
+    for (unsigned i = 1; i < t; ++i) pool.emplace_back(body, i);
+    body(0u);
+    for (std::thread& th : pool) th.join();
+  };
+  run([&](unsigned i) {
+    const std::uint32_t p0 = std::uint32_t(std::uint64_t(paths) * i / t), p1 = std::uint32_t(std::uint64_t(paths) * (i + 1) / t);
+    forEachSplat(p0, p1, [&](std::uint32_t p, std::uint32_t k, glm::vec4 a, glm::vec4, glm::vec4, double) {
+      const std::uint32_t leaf = tree.findLeaf(glm::vec3(a));
+      leafOf[std::size_t(p) * perPath + k] = leaf;
+      ++counts[i][leaf];
+    });
+  });
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> byCount(tree.leafCount());
+  for (std::uint32_t l = 0; l < tree.leafCount(); ++l) {
+    std::uint64_t n = 0;
+    for (unsigned i = 0; i < t; ++i) n += counts[i][l];
+    byCount[l] = {n, l};
+  }
+  std::sort(byCount.begin(), byCount.end(), [](auto& x, auto& y) { return x.first != y.first ? x.first > y.first : x.second < y.second; });
+  std::vector<unsigned> owner(tree.leafCount(), 0);
+  std::vector<std::uint64_t> load(t, 0);
+  for (auto& [n, l] : byCount) {
+    const unsigned i = unsigned(std::min_element(load.begin(), load.end()) - load.begin());
+    owner[l] = i;
+    load[i] += n;
+  }
+  std::vector<std::uint64_t> splats(t, 0);
+  run([&](unsigned i) {
+    forEachSplat(0, paths, [&](std::uint32_t p, std::uint32_t k, glm::vec4 a, glm::vec4 b, glm::vec4 c, double after) {
+      const std::uint32_t leaf = leafOf[std::size_t(p) * perPath + k];
+      if (owner[leaf] != i) return;
+      tree.splatInLeaf(leaf, glm::vec3(b), after / double(b.w));
+      if (c.x >= 0.0f) tree.observeSelection(leaf, after, c.x, c.y, c.z);
+      ++splats[i];
+    });
+  });
+  std::uint64_t total = 0;
+  for (std::uint64_t n : splats) total += n;
+  tree.addSplats(total);
+  return total;
 }
 
 void appendPhotons(const glm::vec4* records, std::uint32_t recordsPerPath, std::uint32_t photons,

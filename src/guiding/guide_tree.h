@@ -174,6 +174,15 @@ class GuideTree {
   void splat(glm::vec3 x, glm::vec3 d, double value, double count = 1.0) { splatAt(findLeaf(x), x, d, value, count); }
   // The same for a vertex x known to lie in leaf `leaf` (findLeaf(x)).
   void splatAt(std::uint32_t leaf, glm::vec3 x, glm::vec3 d, double value, double count = 1.0);
+  // Whether a splat changes nothing outside its own leaf (no spatial filter, or a single leaf):
+  // then the splats of different leaves can be applied in parallel (splatPaths), each leaf's in
+  // their order, giving the same trees bit for bit.
+  bool splatsStayInTheirLeaf() const { return !m_settings.spatialFilter || m_leaves.size() == 1; }
+  // splatAt for a tree whose splats stay in their leaf, touching leaf `leaf` only: the splat is not
+  // counted in the iteration's splats (addSplats adds them), so that threads owning different
+  // leaves can call it at the same time.
+  void splatInLeaf(std::uint32_t leaf, glm::vec3 d, double value, double count = 1.0);
+  void addSplats(std::uint64_t n) { m_splats += n; }
   // A vertex of leaf `leaf` sampled by the mixture: y = its estimate through the sample (the
   // radiance it carried, >= 0), pdfGuide and pdfBsdf = the guide's and the BRDF sampler's
   // densities at the sampled direction, alpha = the selection probability it was drawn with.
@@ -236,8 +245,10 @@ class GuideTree {
 // Splats the training records of `paths` paths (guiding_layout.h: recordsPerPath records of
 // GUIDE_RECORD_VEC4S vec4 per path) with their final radiance (pathRadiance, rgb) into the tree,
 // paths in order, and gives each mixture vertex to observeSelection. Returns the number of splats.
+// With threads > 1 (0: the machine's cores) and splats that stay in their leaf, the leaves are
+// shared among threads, each applying its leaves' splats in path order: the same trees bit for bit.
 std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_t recordsPerPath,
-                         const glm::vec4* pathRadiance, std::uint32_t paths);
+                         const glm::vec4* pathRadiance, std::uint32_t paths, unsigned threads = 0);
 
 // The photon pre-pass (docs/guiding.md, "Photon pre-pass"): one photon's arrival after a bounce.
 struct PhotonSplat {

@@ -290,6 +290,11 @@ SamplerTables buildSamplerTables(const std::vector<std::pair<std::uint32_t, Brdf
   unsigned nThreads = settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
   nThreads = std::max(1u, std::min<unsigned>(nThreads, unsigned(jobs.size())));
   if (!jobs.empty()) {
+    if (settings.beforeBuild) {
+      std::size_t built = 0;
+      for (const Unique& u : uniques) built += u.fromCache ? 0 : 1;
+      settings.beforeBuild(built, jobs.size());
+    }
     std::vector<std::thread> pool;
     for (unsigned i = 1; i < nThreads; ++i) pool.emplace_back(worker);
     worker();

@@ -4,6 +4,7 @@
 // shaders/shared/quadtree.h (quadSample, quadPdf, quadAlbedo) on those arrays.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -23,6 +24,9 @@ struct QuadtreeSettings {
   // Tests only: when not empty, only these theta indices are built (all their phi tables); the
   // other tables stay empty (mass 0: sampling there fails). Never cached.
   std::vector<std::uint32_t> onlyThetaTables;
+  // Called once, before any tree is built, when some materials' trees are not in the cache (a
+  // build can take minutes): how many materials and tables will be built. May be empty.
+  std::function<void(std::size_t materials, std::size_t tables)> beforeBuild;
 };
 
 struct MaterialStats {

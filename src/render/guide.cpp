@@ -41,8 +41,10 @@ DeviceGuide::DeviceGuide(vk::Context& ctx, glm::vec3 lo, glm::vec3 hi, const gui
     : m_ctx(ctx), m_tree(lo, hi, settings), m_recordsPerPath(recordsPerPath(maxDepth)), m_capacity(pathCapacity) {
   m_info = vk::createBuffer(m_ctx, sizeof(GpuGuide), 0, true, "path guide");
   m_arrays = vk::createBuffer(m_ctx, arraysBytes(settings.memoryCap), 0, true, "path guide trees");
-  m_records = vk::createBuffer(m_ctx, std::uint64_t(pathCapacity) * m_recordsPerPath * kRecordBytes, 0, false,
-                               "path guide training records");
+  // Read after every training chunk (hundreds of MiB per second of rendering): mapped where the
+  // device's memory is the host's, else through a staging copy.
+  m_records = vk::createBuffer(m_ctx, std::uint64_t(pathCapacity) * m_recordsPerPath * kRecordBytes, 0,
+                               vk::sharesHostMemory(m_ctx), "path guide training records");
   upload();
 }
 
@@ -102,9 +104,13 @@ void DeviceGuide::setPhotons(bool on) {
 void DeviceGuide::consumePhotons(std::uint32_t photons) {
   if (photons == 0) return;
   const auto t0 = std::chrono::steady_clock::now();
-  m_hostRecords.resize(std::size_t(photons) * m_recordsPerPath * GUIDE_RECORD_VEC4S);
-  vk::downloadBuffer(m_ctx, m_records, m_hostRecords.data(), m_hostRecords.size() * sizeof(glm::vec4));
-  guiding::appendPhotons(m_hostRecords.data(), m_recordsPerPath, photons, m_photons);
+  const glm::vec4* records = static_cast<const glm::vec4*>(m_records.mapped);
+  if (!records) {
+    m_hostRecords.resize(std::size_t(photons) * m_recordsPerPath * GUIDE_RECORD_VEC4S);
+    vk::downloadBuffer(m_ctx, m_records, m_hostRecords.data(), m_hostRecords.size() * sizeof(glm::vec4));
+    records = m_hostRecords.data();
+  }
+  guiding::appendPhotons(records, m_recordsPerPath, photons, m_photons);
   m_seconds += secondsSince(t0);
 }
 
@@ -123,11 +129,19 @@ void DeviceGuide::endPhotons(double countWeight) {
 void DeviceGuide::consumeChunk(const vk::Buffer& pathRadiance, std::uint32_t paths) {
   if (!m_recording || paths == 0) return;
   const auto t0 = std::chrono::steady_clock::now();
-  m_hostRecords.resize(std::size_t(paths) * m_recordsPerPath * GUIDE_RECORD_VEC4S);
-  m_hostRadiance.resize(paths);
-  vk::downloadBuffer(m_ctx, m_records, m_hostRecords.data(), m_hostRecords.size() * sizeof(glm::vec4));
-  vk::downloadBuffer(m_ctx, pathRadiance, m_hostRadiance.data(), m_hostRadiance.size() * sizeof(glm::vec4));
-  guiding::splatPaths(m_tree, m_hostRecords.data(), m_recordsPerPath, m_hostRadiance.data(), paths);
+  const glm::vec4* records = static_cast<const glm::vec4*>(m_records.mapped);
+  if (!records) {
+    m_hostRecords.resize(std::size_t(paths) * m_recordsPerPath * GUIDE_RECORD_VEC4S);
+    vk::downloadBuffer(m_ctx, m_records, m_hostRecords.data(), m_hostRecords.size() * sizeof(glm::vec4));
+    records = m_hostRecords.data();
+  }
+  const glm::vec4* radiance = static_cast<const glm::vec4*>(pathRadiance.mapped);
+  if (!radiance) {
+    m_hostRadiance.resize(paths);
+    vk::downloadBuffer(m_ctx, pathRadiance, m_hostRadiance.data(), m_hostRadiance.size() * sizeof(glm::vec4));
+    radiance = m_hostRadiance.data();
+  }
+  guiding::splatPaths(m_tree, records, m_recordsPerPath, radiance, paths);
   m_seconds += secondsSince(t0);
 }
 

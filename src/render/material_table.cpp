@@ -209,6 +209,14 @@ MaterialTable::MaterialTable(vk::Context& ctx, const Scene& scene, const RenderS
     // The bins' trees are looked up at any texel's wo: full tables (the settings' counts).
     qs.thetaTables = std::max(1u, settings.samplerThetaTables);
     qs.phiTables = std::max(2u, settings.samplerPhiTables);
+    if (settings.notice)
+      qs.beforeBuild = [&settings](std::size_t materials, std::size_t tables) {
+        const std::string dir = quadtree::cacheDirectory();
+        settings.notice("sampler: building the quadtrees of " + std::to_string(materials) + " material" +
+                        (materials == 1 ? "" : "s") + " (" + std::to_string(tables) + " tables; " +
+                        (dir.empty() ? "no writable cache directory" : "cached in " + dir + " for later renders") +
+                        "): a first build can take minutes for some models, see docs/sampler.md");
+      };
     qt = quadtree::buildSamplerTables(toBuild, qs, setOf);
     m_plan.seconds = qt.seconds;
     m_plan.tables = static_cast<std::uint32_t>(qt.tables.size());

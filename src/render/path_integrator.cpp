@@ -65,7 +65,8 @@ PathIntegrator::PathIntegrator(vk::Context& ctx, StageGlobals& globals, const Re
   g.pathOrigin = make(cap * 16, "path origin")->address;
   g.pathDirection = make(cap * 16, "path direction")->address;
   g.pathThroughput = make(cap * 16, "path throughput")->address;
-  m_pathRadiance = make(cap * 16, "path radiance");
+  // Guided renders read it after every training chunk: mapped where that costs the shaders nothing.
+  m_pathRadiance = make(cap * 16, "path radiance", 0, guide && vk::sharesHostMemory(m_ctx));
   g.pathRadiance = m_pathRadiance->address;
   m_pathInfo = make(cap * 16, "path info");
   g.pathInfo = m_pathInfo->address;

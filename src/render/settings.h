@@ -7,6 +7,7 @@
 #pragma once
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -188,6 +189,10 @@ struct RenderSettings {
   // (PathOptions::primaryDims = PathIntegrator::primaryDimsFor(maxDepth); Renderer::paths()), which
   // the caller fills: for tests of the primary sample source. Not a command-line option.
   bool primarySamples = false;
+  // Called with a line of news about long start-up work (a quadtree build that misses the cache,
+  // which can take minutes: "sampler: building ..."); the command line prints it unless --quiet.
+  // Not a command-line option; may be empty.
+  std::function<void(const std::string&)> notice;
   // The part of each path's radiance the path tracer adds (RADIANCE_*, layout.h: 0 all, 1 direct
   // light only, 2 indirect light only; Globals.radiancePart). Not a command-line option: for tests
   // (Metropolis sets its own, mlt_integrator.h).

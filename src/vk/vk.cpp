@@ -471,6 +471,11 @@ VkDeviceSize deviceLocalHeapSize(const Context& ctx) {
   return best;
 }
 
+bool sharesHostMemory(const Context& ctx) {
+  return ctx.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ||
+         ctx.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU;
+}
+
 void destroyBuffer(Context& ctx, Buffer& b) {
   if (b.buffer) vkDestroyBuffer(ctx.device, b.buffer, nullptr);
   if (b.memory) vkFreeMemory(ctx.device, b.memory, nullptr);

@@ -110,6 +110,10 @@ Buffer createBuffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags extraUsa
 void destroyBuffer(Context& ctx, Buffer& buffer);
 // Size of the largest device-local memory heap: what one render's buffers must fit into.
 VkDeviceSize deviceLocalHeapSize(const Context& ctx);
+// Whether the device's memory is the host's (a CPU device such as lavapipe, or an integrated GPU),
+// so that the host can read a buffer the device writes in place, mapped, rather than through a
+// staging copy (which on a discrete GPU keeps device-local memory fast for the shaders).
+bool sharesHostMemory(const Context& ctx);
 // Copies bytes into a buffer (through a staging buffer when it is not host visible).
 void uploadBuffer(Context& ctx, Buffer& buffer, const void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);
 void downloadBuffer(Context& ctx, const Buffer& buffer, void* data, VkDeviceSize bytes, VkDeviceSize offset = 0);

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 
 #include "guiding/guide_tree.h"
@@ -350,6 +351,71 @@ TEST(Guiding, SplatsRadianceFromLaterInThePathOverThroughputAndPdf) {
   EXPECT_EQ(splatPaths(t, rec.data(), n, L.data(), 3), 4u);
   EXPECT_NEAR(t.buildingTree(0).total(), 0.5 + 0.125 + 0.75, 1e-12);
   EXPECT_EQ(t.leafSamples(0), 4.0);
+}
+
+// splatPaths on several threads (each owning some leaves, applying their splats in path order)
+// builds the same trees bit for bit as one thread: random paths with delta samples, ended paths,
+// escaped rays, mixture vertices and a non-finite radiance, into a tree of many regions.
+TEST(Guiding, ParallelSplatsGiveTheSameTreesBitForBit) {
+  GuideSettings s;
+  s.spatialThreshold = 200;
+  s.alpha = -1.0f;  // learned: observeSelection's statistics count too
+  GuideTree base(glm::vec3(0.0f), glm::vec3(1.0f), s);
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<float> U(0.0f, 1.0f);
+  for (int i = 0; i < 20000; ++i) {
+    glm::vec3 d = uniformSphere(rng);
+    base.splat(glm::vec3(U(rng), U(rng) * U(rng), U(rng)), d, radiance(d));  // uneven regions
+  }
+  base.endIteration(0);
+  ASSERT_GE(base.leafCount(), 16u);
+  const std::uint32_t n = 6, R = GUIDE_RECORD_VEC4S, paths = 20000;
+  std::vector<glm::vec4> rec(std::size_t(paths) * n * R, glm::vec4(0.0f)), L(paths);
+  for (std::uint32_t p = 0; p < paths; ++p) {
+    const std::uint32_t len = 1 + std::uint32_t(U(rng) * (n - 1));  // vertices with a sample
+    float arrival = 0.0f;
+    for (std::uint32_t k = 0; k <= len && k < n; ++k) {
+      glm::vec4* r = &rec[(std::size_t(p) * n + k) * R];
+      r[0] = glm::vec4(U(rng), U(rng) * U(rng), U(rng), k == 0 ? 0.0f : (U(rng) < 0.1f ? -1.0f : arrival));
+      if (k == len) break;  // the path ended here: b.w = 0
+      const glm::vec3 d = uniformSphere(rng);
+      const float w = U(rng) < 0.1f ? -1.0f : 0.05f + U(rng);  // -1: a delta sample
+      r[1] = glm::vec4(d, w);
+      r[2] = U(rng) < 0.5f ? glm::vec4(U(rng), U(rng), 0.5f, 0.0f) : glm::vec4(-1.0f, 0.0f, 0.0f, 0.0f);
+      arrival += U(rng);
+    }
+    L[p] = glm::vec4(glm::vec3(arrival + U(rng)), 0.0f);
+  }
+  L[17] = glm::vec4(NAN);
+  auto run = [&](unsigned threads, std::uint64_t& splats) {
+    GuideTree t = base;
+    splats = splatPaths(t, rec.data(), n, L.data(), paths, threads);
+    return t;
+  };
+  std::uint64_t n1 = 0;
+  GuideTree one = run(1, n1);
+  EXPECT_GT(n1, paths);
+  for (unsigned threads : {2u, 3u}) {
+    std::uint64_t nt = 0;
+    GuideTree many = run(threads, nt);
+    EXPECT_EQ(nt, n1) << threads << " threads";
+    for (std::uint32_t l = 0; l < one.leafCount(); ++l) {
+      EXPECT_EQ(one.leafSamples(l), many.leafSamples(l)) << "leaf " << l;
+      EXPECT_EQ(0, std::memcmp(&one.leafSelection(l), &many.leafSelection(l), sizeof(SelectionStats))) << "leaf " << l;
+      EXPECT_EQ(one.buildingTree(l).total(), many.buildingTree(l).total()) << "leaf " << l;
+    }
+    const IterationReport a = one.endIteration(1), b = many.endIteration(1);
+    EXPECT_EQ(a.splats, b.splats);
+    std::vector<shared::GuideSpatialNode> sa, sb;
+    std::vector<shared::GuideDirNode> da, db;
+    one.flatten(sa, da);
+    many.flatten(sb, db);
+    ASSERT_EQ(sa.size(), sb.size());
+    ASSERT_EQ(da.size(), db.size());
+    EXPECT_EQ(0, std::memcmp(sa.data(), sb.data(), sa.size() * sizeof(sa[0]))) << threads << " threads";
+    EXPECT_EQ(0, std::memcmp(da.data(), db.data(), da.size() * sizeof(da[0]))) << threads << " threads";
+    one = run(1, n1);  // endIteration changed it
+  }
 }
 
 // ---- Splat filtering (GuideSettings::dirFilter, spatialFilter) --------------------------------------
