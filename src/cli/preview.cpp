@@ -397,8 +397,6 @@ void Preview::createRenderer(std::uint32_t width, std::uint32_t height) {
   m_settings.width = width;
   m_settings.height = height;
   m_settings.samplesPerPass = 1;  // a frame is one sample per pixel: the window stays responsive
-  // Switching to the quadtree (key S) may build trees: say so before the window stalls.
-  m_settings.notice = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   m_renderer = std::make_unique<Renderer>(m_ctx, m_scene, m_settings);
   if (keepCamera) m_renderer->setCamera(cam);  // the camera of the scene otherwise: same view as `render`
   m_display = vk::createComputePipeline(m_ctx, m_renderer->pipelineLayout(), "display");
@@ -702,6 +700,9 @@ int Preview::run() {
   parseSampler(a.sampler, m_settings.sampler);
   parseTraversal(a.traversal, m_settings.traversal);
   m_settings.spp = 1;
+  // A quadtree build (at start, or on switching to the quadtree with S) is announced before the
+  // window stalls on it.
+  if (!a.quiet) m_settings.notice = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
   // Path guiding (G switches): the open-ended render's training, as `render --time` has it.
   m_settings.guiding = a.guiding == "on";
   m_settings.guideTrainSpp = kPreviewGuideTrainSpp;
