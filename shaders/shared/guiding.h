@@ -60,23 +60,16 @@ SHARED_FN vec3 guideSquareToDirection(vec2 p) {
 
 // info of the spatial leaf whose box holds x (guiding_layout.h: (GUIDE_SPATIAL_LEAF, root,
 // alpha bits, 0)). Points outside the root box go to the nearest leaf along each split. A tree
-// deeper than the loop bound (never built) gives an unguided region (alpha 0).
+// deeper than the loop bound (never built) gives an unguided region (alpha 0). Each inner node
+// holds its split coordinate (the midpoint of its box, as GuideTree::findNode computes it): the
+// descent keeps no box and indexes no array by a variable.
 SHARED_FN uvec4 guideLeafInfo(GuideView G, vec3 x) {
-  vec3 lo = vec3(GUIDE_VIEW_INFO(G).boundsMin.x, GUIDE_VIEW_INFO(G).boundsMin.y, GUIDE_VIEW_INFO(G).boundsMin.z);
-  vec3 hi = vec3(GUIDE_VIEW_INFO(G).boundsMax.x, GUIDE_VIEW_INFO(G).boundsMax.y, GUIDE_VIEW_INFO(G).boundsMax.z);
   uint node = 0u;
   for (uint d = 0u; d < GUIDE_MAX_SPATIAL_DEPTH; ++d) {
     uvec4 info = GUIDE_SPATIAL(G, node).info;
     if (info.x == GUIDE_SPATIAL_LEAF) return info;
-    uint a = info.x;
-    float mid = 0.5f * (lo[a] + hi[a]);
-    if (x[a] < mid) {
-      hi[a] = mid;
-      node = info.y;
-    } else {
-      lo[a] = mid;
-      node = info.y + 1u;
-    }
+    float xa = info.x == 0u ? x.x : (info.x == 1u ? x.y : x.z);
+    node = info.y + (xa < uintBitsToFloat(info.z) ? 0u : 1u);
   }
   return uvec4(GUIDE_SPATIAL_LEAF, 0u, 0u, 0u);
 }

@@ -25,7 +25,8 @@ SHARED_BEGIN
 // they carry little of the image and the record buffer grows with them.
 #define GUIDE_MAX_RECORD_VERTICES 8u
 
-// info = (axis 0..2, first child (the second is first + 1), 0, 0) for inner nodes;
+// info = (axis 0..2, first child (the second is first + 1: x[axis] >= split), bits of the split
+//         coordinate (the midpoint of the node's box along axis), 0) for inner nodes;
 //        (GUIDE_SPATIAL_LEAF, root of the leaf's directional quadtree (GuideDirNode index),
 //         bits of the selection probability alpha of the guide in this region (0: not guided),
 //         0) for leaves.

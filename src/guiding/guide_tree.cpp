@@ -402,7 +402,9 @@ void GuideTree::flatten(std::vector<shared::GuideSpatialNode>& spatial, std::vec
   for (std::size_t i = 0; i < m_nodes.size(); ++i) {
     const SpatialNode& n = m_nodes[i];
     if (n.axis != GUIDE_SPATIAL_LEAF) {
-      spatial[i].info = shared::uvec4(n.axis, n.child, 0u, 0u);
+      // The split as findNode computes it from the box (guideLeafInfo reads it).
+      const float mid = 0.5f * (n.lo[n.axis] + n.hi[n.axis]);
+      spatial[i].info = shared::uvec4(n.axis, n.child, shared::floatBitsToUint(mid), 0u);
       continue;
     }
     const DirTree& t = m_leaves[n.leaf].sampling;
