@@ -466,7 +466,7 @@ struct BenchArgs {
   std::vector<std::string> traversals{"auto"};
   std::uint32_t repeats = 1;
   std::string guiding = "off";
-  std::uint32_t guideTrain = 1;
+  std::uint32_t guideTrain = 15;
   std::string guideAlpha = "0.5";
   EnvironmentArgs env;
 };
@@ -505,7 +505,11 @@ BenchRun benchRenderOnce(vk::Context& ctx, const Scene& scene, const std::string
   const auto tSetup = std::chrono::steady_clock::now();
   Renderer r(ctx, scene, s);
   const auto tWarm = std::chrono::steady_clock::now();
-  r.renderPass(1);  // warm-up: lavapipe compiles each pipeline at its first dispatch
+  // Warm-up, untimed: one pass (lavapipe compiles each pipeline at its first dispatch), and for a
+  // guided run all of its training, so that the timed passes sample the trained guide (the
+  // training's own cost is in render's summary).
+  const std::uint32_t warmSpp = s.guiding ? std::max(1u, guideTrainingSpp(s)) : 1u;
+  r.render(warmSpp);
   run.setupSeconds = std::chrono::duration<double>(tWarm - tSetup).count();
   run.warmupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tWarm).count();
   const std::vector<std::pair<std::string, double>> warm = r.stageSeconds();
@@ -513,7 +517,7 @@ BenchRun benchRenderOnce(vk::Context& ctx, const Scene& scene, const std::string
   const RenderStats before = r.stats();
   const double cpu0 = cpuSecondsUsed();
   const auto t0 = std::chrono::steady_clock::now();
-  r.render(1 + a.spp);
+  r.render(warmSpp + a.spp);
   const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double cpu = cpuSecondsUsed() - cpu0;
   const RenderStats after = r.stats();
@@ -914,7 +918,7 @@ int runCli(int argc, char** argv) {
   bench->require_subcommand(1);
   CLI::App* benchRender = bench->add_subcommand("render", "Samples/s and rays/s for the default scene and the dragon");
   benchRender->add_option("scenes", ba.scenes, "Scenes to measure (default: the Cornell box and scenes/dragon)");
-  benchRender->add_option("--spp", ba.spp, "Timed samples per pixel (after one warm-up pass)")->capture_default_str()
+  benchRender->add_option("--spp", ba.spp, "Timed samples per pixel (after an untimed warm-up: one pass, or a guided run's training)")->capture_default_str()
       ->check(CLI::Range(1u, 1u << 20));
   benchRender->add_option("--width", ba.width, "Image width")->capture_default_str()->check(CLI::Range(1u, 65536u));
   benchRender->add_option("--height", ba.height, "Image height")->capture_default_str()->check(CLI::Range(1u, 65536u));
@@ -930,8 +934,9 @@ int runCli(int argc, char** argv) {
       ->check(CLI::IsMember(enumNames(kTraversalNames)));
   benchRender->add_option("--guiding", ba.guiding, "Path guiding: on or off (docs/guiding.md)")
       ->capture_default_str()->check(CLI::IsMember({"off", "on"}));
-  benchRender->add_option("--guide-train", ba.guideTrain, "Guided: training spp (1: the warm-up pass only, so that "
-                                                          "the timed passes sample a fixed guide)")
+  benchRender->add_option("--guide-train", ba.guideTrain, "Guided: training spp, rendered in the untimed warm-up: the "
+                                                          "timed passes sample the trained guide (the training's cost: "
+                                                          "render's summary)")
       ->capture_default_str()->check(CLI::Range(1u, 1u << 30));
   benchRender->add_option("--guide-alpha", ba.guideAlpha, "Guided: probability of sampling the guide in [0, 1] (0: the "
                                                           "guided pipelines run but never take the guide's branch), "
