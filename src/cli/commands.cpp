@@ -311,6 +311,8 @@ int renderCommand(const RenderArgs& a) {
     lo.output = output;
     lo.variance = a.variance;
     lo.quiet = a.quiet;
+    // With a time budget the automatic training ends where the budget says (docs/guiding.md).
+    lo.trainingWithinBudget = s.guiding && a.timeBudget > 0 && a.guideTrain == 0 && a.resume.empty();
     RenderLoop loop(renderer, base, previous, lo);
     loop.run();
     RenderRecord rec = loop.record(false);
@@ -324,9 +326,11 @@ int renderCommand(const RenderArgs& a) {
       // A render that stopped (--time, an interrupt) before the end of training says so.
       const std::uint32_t planned = renderer.summary().guideTrainSpp;
       const std::uint32_t trained = std::min<std::uint64_t>(planned, rec.spp);
+      std::string why = trained < planned ? " of " + std::to_string(planned) + " (stopped during training)" : "";
+      if (loop.trainingEndedAt())
+        why = " (ended by the time budget: the next iteration would have left less than its own time to sample its guide)";
       std::fprintf(stderr, "guiding: %u training spp%s, %.3f s of CPU time reading records, splatting and refining\n",
-                   trained, trained < planned ? (" of " + std::to_string(planned) + " (stopped during training)").c_str() : "",
-                   guide->trainingSeconds());
+                   trained, why.c_str(), guide->trainingSeconds());
     }
     if (const MltIntegrator* mlt = renderer.mlt(); mlt && !a.quiet) {
       const MltReport& m = mlt->report();
@@ -877,7 +881,9 @@ int runCli(int argc, char** argv) {
                                               "sampler), off = BSDF sampling only")
       ->capture_default_str()->check(CLI::IsMember({"off", "on"}));
   render->add_option("--guide-train", ra.guideTrain, "Training samples per pixel of the guide, in iterations of 1, 2, 4, "
-                                                     "... spp (0: the largest 2^k - 1 up to half of --spp, at most 127)")
+                                                     "... spp (0: the largest 2^k - 1 up to half of --spp, at most 127; "
+                                                     "with --time, ended earlier when the next iteration would leave less "
+                                                     "than its own time to sample its guide)")
       ->capture_default_str()->check(CLI::Range(0u, 1u << 30));
   render->add_option("--guide-memory", ra.guideMemoryMiB, "Memory cap of the guide's trees on the device, MiB")
       ->capture_default_str()->check(CLI::Range(0.01, 4096.0));
