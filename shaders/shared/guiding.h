@@ -60,23 +60,16 @@ SHARED_FN vec3 guideSquareToDirection(vec2 p) {
 
 // info of the spatial leaf whose box holds x (guiding_layout.h: (GUIDE_SPATIAL_LEAF, root,
 // alpha bits, 0)). Points outside the root box go to the nearest leaf along each split. A tree
-// deeper than the loop bound (never built) gives an unguided region (alpha 0).
+// deeper than the loop bound (never built) gives an unguided region (alpha 0). Each inner node
+// holds its split coordinate (the midpoint of its box, as GuideTree::findNode computes it): the
+// descent keeps no box and indexes no array by a variable.
 SHARED_FN uvec4 guideLeafInfo(GuideView G, vec3 x) {
-  vec3 lo = vec3(GUIDE_VIEW_INFO(G).boundsMin.x, GUIDE_VIEW_INFO(G).boundsMin.y, GUIDE_VIEW_INFO(G).boundsMin.z);
-  vec3 hi = vec3(GUIDE_VIEW_INFO(G).boundsMax.x, GUIDE_VIEW_INFO(G).boundsMax.y, GUIDE_VIEW_INFO(G).boundsMax.z);
   uint node = 0u;
   for (uint d = 0u; d < GUIDE_MAX_SPATIAL_DEPTH; ++d) {
     uvec4 info = GUIDE_SPATIAL(G, node).info;
     if (info.x == GUIDE_SPATIAL_LEAF) return info;
-    uint a = info.x;
-    float mid = 0.5f * (lo[a] + hi[a]);
-    if (x[a] < mid) {
-      hi[a] = mid;
-      node = info.y;
-    } else {
-      lo[a] = mid;
-      node = info.y + 1u;
-    }
+    float xa = info.x == 0u ? x.x : (info.x == 1u ? x.y : x.z);
+    node = info.y + (xa < uintBitsToFloat(info.z) ? 0u : 1u);
   }
   return uvec4(GUIDE_SPATIAL_LEAF, 0u, 0u, 0u);
 }
@@ -215,9 +208,19 @@ void guideRecordPhoton(uint path, uint bounce, vec3 x, vec3 wFrom, float value) 
   uint n = g.guide.v[0].info.x;
   if (bounce >= n) return;
   GuideRecords R = g.guide.v[0].records;
-  uint i = (path * n + bounce) * GUIDE_RECORD_VEC4S;
+  uint i = guideRecordIndex(path, bounce, g.chunkPaths);
   R.v[i] = vec4(x, value);
   R.v[i + 1u] = vec4(wFrom, 1.0f);
+}
+
+// A camera path's first record reads "ended at vertex 0" until a stage writes its arrival there
+// (a camera ray that leaves a scene without environment never reaches one). With the resets of
+// guideRecordSample, every record the trainer reads is written in the pass that reads it: the
+// record buffer needs no clearing between passes.
+void guideRecordStart(uint path) {
+  if (g.guide.v[0].info.x == 0u) return;
+  GuideRecords R = g.guide.v[0].records;
+  R.v[guideRecordIndex(path, 0u, g.chunkPaths) + 1u] = vec4(0.0f);
 }
 
 // Training record k = bounce of this path (guiding_layout.h): its ray arrived at x with the path
@@ -227,7 +230,7 @@ void guideRecordArrival(uint path, uint bounce, vec3 x) {
   uint n = g.guide.v[0].info.x;
   if (bounce >= n) return;
   GuideRecords R = g.guide.v[0].records;
-  uint i = (path * n + bounce) * GUIDE_RECORD_VEC4S;
+  uint i = guideRecordIndex(path, bounce, g.chunkPaths);
   R.v[i] = vec4(x, luminance(g.pathRadiance.v[path].xyz));
   R.v[i + 1u] = vec4(0.0f);
 }
@@ -235,15 +238,20 @@ void guideRecordArrival(uint path, uint bounce, vec3 x) {
 // The path goes on from vertex `bounce` in the world direction wi; value = luminance of the new
 // throughput x the sample's density per steradian, or -1 (a delta sample: not splatted);
 // selection = (guide density, BRDF-sampler density, alpha) of the sample (guiding_layout.h, c).
-// The next record's arrival is reset to -1 (nothing arrived) until a stage writes it.
+// The next record reads "nothing arrived (-1), ended there" until a stage writes its arrival (a
+// ray that leaves a scene without environment, or a path the next bounce ends, never gets one).
 void guideRecordSample(uint path, uint bounce, vec3 wi, float value, vec3 selection) {
   uint n = g.guide.v[0].info.x;
   if (bounce >= n) return;
   GuideRecords R = g.guide.v[0].records;
-  uint i = (path * n + bounce) * GUIDE_RECORD_VEC4S;
+  uint i = guideRecordIndex(path, bounce, g.chunkPaths);
   R.v[i + 1u] = vec4(wi, value > 0.0f ? value : -1.0f);  // 0 would read as "ended here"
   R.v[i + 2u] = vec4(selection, 0.0f);
-  if (bounce + 1u < n) R.v[i + GUIDE_RECORD_VEC4S].w = -1.0f;
+  if (bounce + 1u < n) {
+    uint j = guideRecordIndex(path, bounce + 1u, g.chunkPaths);
+    R.v[j] = vec4(0.0f, 0.0f, 0.0f, -1.0f);
+    R.v[j + 1u] = vec4(0.0f);
+  }
 }
 #else
 // A module without guiding (NUSSELT_SCENE_FEATURES 0, stage_common.glsl): empty stand-ins.
@@ -258,6 +266,7 @@ bool guideRecording() { return false; }
 bool guidePhotons() { return false; }
 void guideRecordPhoton(uint path, uint bounce, vec3 x, vec3 wFrom, float value) {}
 void guideRecordArrival(uint path, uint bounce, vec3 x) {}
+void guideRecordStart(uint path) {}
 void guideRecordSample(uint path, uint bounce, vec3 wi, float value, vec3 selection) {}
 #endif
 #endif

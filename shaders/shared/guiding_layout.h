@@ -25,7 +25,8 @@ SHARED_BEGIN
 // they carry little of the image and the record buffer grows with them.
 #define GUIDE_MAX_RECORD_VERTICES 8u
 
-// info = (axis 0..2, first child (the second is first + 1), 0, 0) for inner nodes;
+// info = (axis 0..2, first child (the second is first + 1: x[axis] >= split), bits of the split
+//         coordinate (the midpoint of the node's box along axis), 0) for inner nodes;
 //        (GUIDE_SPATIAL_LEAF, root of the leaf's directional quadtree (GuideDirNode index),
 //         bits of the selection probability alpha of the guide in this region (0: not guided),
 //         0) for leaves.
@@ -54,8 +55,9 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer GuideRecord
 #endif
 
 // Training records (written by the shade and escape stages while info.x > 0): per path
-// info.x records of GUIDE_RECORD_VEC4S vec4s, record k of path p at (p * info.x + k) *
-// GUIDE_RECORD_VEC4S:
+// info.x records of GUIDE_RECORD_VEC4S vec4s, record k of path p of a chunk of n paths at
+// guideRecordIndex(p, k, n) (bounce-major: a stage's invocations, which shade one bounce of
+// consecutive paths, write consecutive records; the reader walks info.x sequential streams):
 //   a = (position of vertex k (xyz), luminance of the path's radiance when its ray arrived at
 //        vertex k, before anything vertex k adds; -1: the ray left the scene without an
 //        environment, so nothing arrived);
@@ -76,6 +78,8 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer GuideRecord
 //   a = (position (xyz), luminance of the photon's power on arrival);
 //   b = (unit world direction towards where it came from, 1); b.w = 0: no record.
 #define GUIDE_RECORD_VEC4S 3u
+// The first vec4 of record k of path p (chunk-local) in a chunk of `paths` paths.
+SHARED_FN uint guideRecordIndex(uint path, uint k, uint paths) { return (k * paths + path) * GUIDE_RECORD_VEC4S; }
 // boundsMin, boundsMax: the spatial tree's root box (w unused);
 // info = (records per path, 0: not recording; 1: the photon pre-pass, else 0; 0, 0).
 struct GpuGuide {

@@ -46,6 +46,7 @@ void main() {
   g.pathThroughput.v[i] = vec4(1.0f, 1.0f, 1.0f, 1.0f);  // w: etaScale
   g.pathRadiance.v[i] = vec4(0.0f);
   g.pathInfo.v[i] = uvec4(pixel, sampleIndex, 0u, 0u);
+  if (GUIDING) guideRecordStart(i);  // a training pass's first record (guiding.h)
   g.queues.v[QUEUE_HEADER_UINTS + QUEUE_RAY0 * g.pathCapacity + i] = i;
   if (i == 0u) {
     g.queues.v[QUEUE_RAY0] = g.chunkPaths;

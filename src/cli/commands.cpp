@@ -311,6 +311,8 @@ int renderCommand(const RenderArgs& a) {
     lo.output = output;
     lo.variance = a.variance;
     lo.quiet = a.quiet;
+    // With a time budget the automatic training ends where the budget says (docs/guiding.md).
+    lo.trainingWithinBudget = s.guiding && a.timeBudget > 0 && a.guideTrain == 0 && a.resume.empty();
     RenderLoop loop(renderer, base, previous, lo);
     loop.run();
     RenderRecord rec = loop.record(false);
@@ -324,9 +326,11 @@ int renderCommand(const RenderArgs& a) {
       // A render that stopped (--time, an interrupt) before the end of training says so.
       const std::uint32_t planned = renderer.summary().guideTrainSpp;
       const std::uint32_t trained = std::min<std::uint64_t>(planned, rec.spp);
+      std::string why = trained < planned ? " of " + std::to_string(planned) + " (stopped during training)" : "";
+      if (loop.trainingEndedAt())
+        why = " (ended by the time budget: the next iteration would have left less than its own time to sample its guide)";
       std::fprintf(stderr, "guiding: %u training spp%s, %.3f s of CPU time reading records, splatting and refining\n",
-                   trained, trained < planned ? (" of " + std::to_string(planned) + " (stopped during training)").c_str() : "",
-                   guide->trainingSeconds());
+                   trained, why.c_str(), guide->trainingSeconds());
     }
     if (const MltIntegrator* mlt = renderer.mlt(); mlt && !a.quiet) {
       const MltReport& m = mlt->report();
@@ -466,7 +470,7 @@ struct BenchArgs {
   std::vector<std::string> traversals{"auto"};
   std::uint32_t repeats = 1;
   std::string guiding = "off";
-  std::uint32_t guideTrain = 1;
+  std::uint32_t guideTrain = 15;
   std::string guideAlpha = "0.5";
   EnvironmentArgs env;
 };
@@ -505,7 +509,11 @@ BenchRun benchRenderOnce(vk::Context& ctx, const Scene& scene, const std::string
   const auto tSetup = std::chrono::steady_clock::now();
   Renderer r(ctx, scene, s);
   const auto tWarm = std::chrono::steady_clock::now();
-  r.renderPass(1);  // warm-up: lavapipe compiles each pipeline at its first dispatch
+  // Warm-up, untimed: one pass (lavapipe compiles each pipeline at its first dispatch), and for a
+  // guided run all of its training, so that the timed passes sample the trained guide (the
+  // training's own cost is in render's summary).
+  const std::uint32_t warmSpp = s.guiding ? std::max(1u, guideTrainingSpp(s)) : 1u;
+  r.render(warmSpp);
   run.setupSeconds = std::chrono::duration<double>(tWarm - tSetup).count();
   run.warmupSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tWarm).count();
   const std::vector<std::pair<std::string, double>> warm = r.stageSeconds();
@@ -513,7 +521,7 @@ BenchRun benchRenderOnce(vk::Context& ctx, const Scene& scene, const std::string
   const RenderStats before = r.stats();
   const double cpu0 = cpuSecondsUsed();
   const auto t0 = std::chrono::steady_clock::now();
-  r.render(1 + a.spp);
+  r.render(warmSpp + a.spp);
   const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double cpu = cpuSecondsUsed() - cpu0;
   const RenderStats after = r.stats();
@@ -873,7 +881,9 @@ int runCli(int argc, char** argv) {
                                               "sampler), off = BSDF sampling only")
       ->capture_default_str()->check(CLI::IsMember({"off", "on"}));
   render->add_option("--guide-train", ra.guideTrain, "Training samples per pixel of the guide, in iterations of 1, 2, 4, "
-                                                     "... spp (0: the largest 2^k - 1 up to half of --spp, at most 127)")
+                                                     "... spp (0: the largest 2^k - 1 up to half of --spp, at most 127; "
+                                                     "with --time, ended earlier when the next iteration would leave less "
+                                                     "than its own time to sample its guide)")
       ->capture_default_str()->check(CLI::Range(0u, 1u << 30));
   render->add_option("--guide-memory", ra.guideMemoryMiB, "Memory cap of the guide's trees on the device, MiB")
       ->capture_default_str()->check(CLI::Range(0.01, 4096.0));
@@ -914,7 +924,7 @@ int runCli(int argc, char** argv) {
   bench->require_subcommand(1);
   CLI::App* benchRender = bench->add_subcommand("render", "Samples/s and rays/s for the default scene and the dragon");
   benchRender->add_option("scenes", ba.scenes, "Scenes to measure (default: the Cornell box and scenes/dragon)");
-  benchRender->add_option("--spp", ba.spp, "Timed samples per pixel (after one warm-up pass)")->capture_default_str()
+  benchRender->add_option("--spp", ba.spp, "Timed samples per pixel (after an untimed warm-up: one pass, or a guided run's training)")->capture_default_str()
       ->check(CLI::Range(1u, 1u << 20));
   benchRender->add_option("--width", ba.width, "Image width")->capture_default_str()->check(CLI::Range(1u, 65536u));
   benchRender->add_option("--height", ba.height, "Image height")->capture_default_str()->check(CLI::Range(1u, 65536u));
@@ -930,8 +940,9 @@ int runCli(int argc, char** argv) {
       ->check(CLI::IsMember(enumNames(kTraversalNames)));
   benchRender->add_option("--guiding", ba.guiding, "Path guiding: on or off (docs/guiding.md)")
       ->capture_default_str()->check(CLI::IsMember({"off", "on"}));
-  benchRender->add_option("--guide-train", ba.guideTrain, "Guided: training spp (1: the warm-up pass only, so that "
-                                                          "the timed passes sample a fixed guide)")
+  benchRender->add_option("--guide-train", ba.guideTrain, "Guided: training spp, rendered in the untimed warm-up: the "
+                                                          "timed passes sample the trained guide (the training's cost: "
+                                                          "render's summary)")
       ->capture_default_str()->check(CLI::Range(1u, 1u << 30));
   benchRender->add_option("--guide-alpha", ba.guideAlpha, "Guided: probability of sampling the guide in [0, 1] (0: the "
                                                           "guided pipelines run but never take the guide's branch), "

@@ -402,7 +402,9 @@ void GuideTree::flatten(std::vector<shared::GuideSpatialNode>& spatial, std::vec
   for (std::size_t i = 0; i < m_nodes.size(); ++i) {
     const SpatialNode& n = m_nodes[i];
     if (n.axis != GUIDE_SPATIAL_LEAF) {
-      spatial[i].info = shared::uvec4(n.axis, n.child, 0u, 0u);
+      // The split as findNode computes it from the box (guideLeafInfo reads it).
+      const float mid = 0.5f * (n.lo[n.axis] + n.hi[n.axis]);
+      spatial[i].info = shared::uvec4(n.axis, n.child, shared::floatBitsToUint(mid), 0u);
       continue;
     }
     const DirTree& t = m_leaves[n.leaf].sampling;
@@ -415,7 +417,6 @@ void GuideTree::flatten(std::vector<shared::GuideSpatialNode>& spatial, std::vec
 
 std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_t recordsPerPath,
                          const glm::vec4* pathRadiance, std::uint32_t paths, unsigned threads) {
-  constexpr std::uint32_t R = GUIDE_RECORD_VEC4S;
   if (recordsPerPath < 2) return 0;
   const std::uint32_t perPath = recordsPerPath - 1;  // splat slots per path: vertices 0 .. recordsPerPath - 2
   // Calls fn(p, k, x, d, sample record, arrived-after radiance) for every splat of paths [p0, p1), in order.
@@ -424,16 +425,16 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
       const glm::vec4 L = pathRadiance[p];
       const double lEnd = shared::luminance(shared::vec3(L.x, L.y, L.z));
       if (!std::isfinite(lEnd)) continue;  // dropped from the film too
-      const glm::vec4* r = records + std::size_t(p) * recordsPerPath * R;
       for (std::uint32_t k = 0; k < perPath; ++k) {
-        const glm::vec4 b = r[R * k + 1];
+        const glm::vec4* r = records + shared::guideRecordIndex(p, k, paths);
+        const glm::vec4 b = r[1];
         if (b.w == 0.0f) break;       // the path ended at vertex k
         if (!(b.w > 0.0f)) continue;  // a delta sample: the path goes on, nothing to splat
-        const float arrived = r[R * (k + 1)].w;
+        const float arrived = records[shared::guideRecordIndex(p, k + 1, paths)].w;
         // What reached vertex k through its sample: everything the path gathered from vertex k + 1's
         // arrival on; nothing when that ray left a scene without environment (-1).
         const double after = arrived < 0.0f ? 0.0 : std::max(0.0, lEnd - double(arrived));
-        fn(p, k, r[R * k], b, r[R * k + 2], after);
+        fn(p, k, r[0], b, r[2], after);
       }
     }
   };
@@ -486,7 +487,7 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
   }
   std::vector<std::uint64_t> splats(t, 0);
   run([&](unsigned i) {
-    forEachSplat(0, paths, [&](std::uint32_t p, std::uint32_t k, glm::vec4 a, glm::vec4 b, glm::vec4 c, double after) {
+    forEachSplat(0, paths, [&](std::uint32_t p, std::uint32_t k, glm::vec4, glm::vec4 b, glm::vec4 c, double after) {
       const std::uint32_t leaf = leafOf[std::size_t(p) * perPath + k];
       if (owner[leaf] != i) return;
       tree.splatInLeaf(leaf, glm::vec3(b), after / double(b.w));
@@ -502,11 +503,10 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
 
 void appendPhotons(const glm::vec4* records, std::uint32_t recordsPerPath, std::uint32_t photons,
                    std::vector<PhotonSplat>& out) {
-  constexpr std::uint32_t R = GUIDE_RECORD_VEC4S;
   for (std::uint32_t p = 0; p < photons; ++p) {
-    const glm::vec4* r = records + std::size_t(p) * recordsPerPath * R;
     for (std::uint32_t k = 1; k < recordsPerPath; ++k) {
-      const glm::vec4 a = r[R * k], b = r[R * k + 1];
+      const glm::vec4* r = records + shared::guideRecordIndex(p, k, photons);
+      const glm::vec4 a = r[0], b = r[1];
       if (b.w != 1.0f || !(a.w > 0.0f) || !std::isfinite(a.w)) continue;
       out.push_back({glm::vec3(a), glm::vec3(b), a.w});
     }

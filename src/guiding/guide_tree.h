@@ -242,8 +242,8 @@ class GuideTree {
   std::uint64_t m_splats = 0;
 };
 
-// Splats the training records of `paths` paths (guiding_layout.h: recordsPerPath records of
-// GUIDE_RECORD_VEC4S vec4 per path) with their final radiance (pathRadiance, rgb) into the tree,
+// Splats the training records of a chunk of `paths` paths (guiding_layout.h: recordsPerPath records
+// of GUIDE_RECORD_VEC4S vec4 per path, at guideRecordIndex) with their final radiance (pathRadiance, rgb) into the tree,
 // paths in order, and gives each mixture vertex to observeSelection. Returns the number of splats.
 // With threads > 1 (0: the machine's cores) and splats that stay in their leaf, the leaves are
 // shared among threads, each applying its leaves' splats in path order: the same trees bit for bit.
@@ -256,8 +256,8 @@ struct PhotonSplat {
   glm::vec3 d;      // unit direction towards where it came from
   float value = 0;  // luminance of its power
 };
-// Appends the photon records of `photons` photons (guiding_layout.h, "Photon records":
-// recordsPerPath records per photon) to out, photons in order, records k = 1, 2, ... in order.
+// Appends the photon records of a chunk of `photons` photons (guiding_layout.h, "Photon records":
+// recordsPerPath records per photon, at guideRecordIndex) to out, photons in order, records k = 1, 2, ... in order.
 void appendPhotons(const glm::vec4* records, std::uint32_t recordsPerPath, std::uint32_t photons,
                    std::vector<PhotonSplat>& out);
 // The photons' guide: `rounds` times, every splat in order into the building trees, then

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <thread>
 
@@ -142,9 +143,12 @@ void PathIntegrator::createPipelines() {
   // Constant 11 (stage_common.glsl): PRIMARY_SAMPLES, in the stages that draw a path's numbers
   // (camera, shade, escape) when the paths read primary sample vectors.
   const std::uint32_t primary = m_options.primaryDims ? 1u : 0u;
-  if (primary)
+  // Constant 10 (stage_common.glsl): GUIDING, in the camera (a training pass's first records), shade
+  // and escape stages of guided renders.
+  const std::uint32_t guiding = m_guide ? 1u : 0u;
+  if (primary || guiding)
     m_camera = vk::createComputePipeline(m_ctx, layout, "camera",
-                                         {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, primary, m_options.imageSamples ? 1u : 0u});
+                                         {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, guiding, primary, m_options.imageSamples ? 1u : 0u});
   else m_camera = vk::createComputePipeline(m_ctx, layout, "camera");
   // The tracing stages' module for the traversal (the Renderer resolved Auto): <stage>_rq with ray
   // queries, <stage> with the GLSL BVH (CMakeLists.txt). Only the used one is compiled.
@@ -156,8 +160,6 @@ void PathIntegrator::createPipelines() {
   // Modules with alpha coverage compiled in are <stage>_a (CMakeLists.txt, stage_common.glsl).
   const std::string alpha = m_hasAlpha ? "_a" : "";
   m_intersect = vk::createComputePipeline(m_ctx, layout, "intersect" + tracing + alpha, traceSpec);
-  // Constant 10 (stage_common.glsl): GUIDING, in the shade and escape stages of guided renders.
-  const std::uint32_t guiding = m_guide ? 1u : 0u;
   if (m_hasEscape) {
     if (m_guide || primary)
       m_escape = vk::createComputePipeline(m_ctx, layout, "escape_f",
@@ -247,9 +249,13 @@ void PathIntegrator::recordPass(VkCommandBuffer cmd, std::uint32_t chunkCount, b
   // All queues start empty (counts and dispatch sizes).
   vkCmdFillBuffer(cmd, m_queues->buffer, 0, QUEUE_HEADER_UINTS * 4, 0);
   vkCmdFillBuffer(cmd, m_args->buffer, 0, VK_WHOLE_SIZE, 0);
-  // Path guiding's training records (and the photon pre-pass's) start as "ended here"
-  // (guiding_layout.h).
-  if (m_guide && (m_guide->recording() || start)) vkCmdFillBuffer(cmd, m_guide->records().buffer, 0, VK_WHOLE_SIZE, 0);
+  // The photon pre-pass's records start as "no record" (guiding_layout.h). A training pass's need
+  // no clearing: the camera, shade and escape stages write every record the trainer reads
+  // (guiding.h, guideRecordStart). Its test (tests/render/test_guiding.cpp) fills them with 1.0f
+  // first (NUSSELT_TEST_POISON_GUIDE_RECORDS), which then must change nothing.
+  if (m_guide && start == &m_photon) vkCmdFillBuffer(cmd, m_guide->records().buffer, 0, VK_WHOLE_SIZE, 0);
+  else if (m_guide && m_guide->recording() && std::getenv("NUSSELT_TEST_POISON_GUIDE_RECORDS"))
+    vkCmdFillBuffer(cmd, m_guide->records().buffer, 0, VK_WHOLE_SIZE, 0x3f800000u);
   vk::computeBarrier(cmd);
 
   BounceConstants pc{};

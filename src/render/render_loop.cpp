@@ -44,6 +44,7 @@ bool RenderLoop::interrupted() const { return g_stopSignal != 0; }
 bool RenderLoop::step() {
   if (m_renderer.samplesDone() >= m_options.spp || g_stopSignal != 0) return false;
   if (m_options.timeBudget > 0 && seconds() >= m_options.timeBudget) return false;
+  if (m_options.trainingWithinBudget && m_options.timeBudget > 0) planTraining();
   try {
     m_renderer.renderPass(m_options.spp - m_renderer.samplesDone());
   } catch (const Error& e) {
@@ -65,6 +66,23 @@ bool RenderLoop::step() {
     m_lastCheckpoint = std::chrono::steady_clock::now();
   }
   return true;
+}
+
+// At the end of each training iteration k (2^(k+1) - 1 spp trained), iteration k + 1 would trace
+// twice its samples, in about twice its time t: it runs if it would still leave that time, 2t,
+// for rendering with its guide (now + 2t + 2t within the budget); otherwise the training ends
+// and the rest of the budget samples iteration k's guide without recording. Iterations 0 and 1
+// always run: the first pass's time includes the pipelines' compilation at their first dispatch
+// (lavapipe) and the photon pre-pass.
+void RenderLoop::planTraining() {
+  const std::uint32_t trained = m_renderer.guideTrainedSpp();
+  if (trained == m_iterationEndSpp || ((trained + 1) & trained) != 0) return;  // mid-iteration, or seen
+  if (trained >= guideTrainingSpp(m_renderer.settings())) return;              // the training is over
+  const double now = seconds(), last = now - m_iterationEndSeconds;
+  m_iterationEndSpp = trained;
+  m_iterationEndSeconds = now;
+  if (trained < 3) return;
+  if (now + 4.0 * last > m_options.timeBudget && m_renderer.endTraining()) m_trainingEndedAt = trained;
 }
 
 void RenderLoop::run() {
@@ -89,6 +107,7 @@ RenderRecord RenderLoop::record(bool checkpoint) const {
   r.renderSeconds = m_previous.renderSeconds + seconds();
   r.totalSeconds = m_previous.totalSeconds + secondsSince(m_start) + m_base.totalSeconds;
   r.timeBudget = m_options.timeBudget;
+  r.settings.guideTrainSpp = m_renderer.settings().guideTrainSpp;  // planTraining may have ended it early
   if (const DeviceGuide* guide = m_renderer.guide()) r.guideHash = guide->hashText();
   return r;
 }

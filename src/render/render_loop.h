@@ -24,6 +24,11 @@ struct RenderLoopOptions {
   bool variance = false;         // write the variance of the mean (var.R/G/B)
   bool quiet = false;
   bool progress = true;          // a progress bar on a terminal, a summary line otherwise
+  // Guided renders with a time budget: end the guide's training at the end of an iteration when the
+  // next one (twice its samples) would leave less than its own time for rendering with its guide
+  // (docs/guiding.md, "Training within a time budget"). Off when the training spp were asked for
+  // (--guide-train) or come from a resumed render's record.
+  bool trainingWithinBudget = false;
 };
 
 class RenderLoop {
@@ -52,6 +57,8 @@ class RenderLoop {
   double seconds() const;
   // The preview's display exposure, recorded with its saves.
   void setDisplayExposure(double stops) { m_base.displayExposure = stops; }
+  // The training spp the time budget ended the guide's training at (0: it did not).
+  std::uint32_t trainingEndedAt() const { return m_trainingEndedAt; }
 
  private:
   Renderer& m_renderer;
@@ -62,6 +69,11 @@ class RenderLoop {
   std::chrono::steady_clock::time_point m_start;
   std::chrono::steady_clock::time_point m_lastCheckpoint;
   std::uint32_t m_checkpointSpp = 0;
+  // trainingWithinBudget: the training spp at the end of the last iteration seen, when it ended (s).
+  void planTraining();
+  std::uint32_t m_iterationEndSpp = 0;
+  double m_iterationEndSeconds = 0;
+  std::uint32_t m_trainingEndedAt = 0;
 };
 
 }  // namespace nusselt

@@ -269,6 +269,16 @@ void Renderer::renderPass(std::uint32_t samples) {
   if (training && m_guideSamples == iterationEnd) m_guide->endIteration(iteration);
 }
 
+bool Renderer::endTraining() {
+  if (!m_guide) return false;
+  const std::uint32_t trained = m_guideSamples;
+  if (trained < 1 || trained >= guideTrainingSpp(m_settings) || ((trained + 1) & trained) != 0) return false;
+  m_settings.guideTrainSpp = trained;
+  m_summary.guideTrainSpp = trained;
+  m_guide->setRecording(false);
+  return true;
+}
+
 void Renderer::render(std::uint32_t spp) {
   while (m_samples < spp) renderPass(spp - m_samples);
 }

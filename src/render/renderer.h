@@ -107,6 +107,11 @@ class Renderer {
   std::uint32_t guideTrainedSpp() const {
     return m_guide ? std::min(m_guideSamples, guideTrainingSpp(m_settings)) : 0;
   }
+  // Path guiding: ends the training where it stands, at the end of an iteration (guideTrainedSpp()
+  // of the form 2^k - 1, k >= 1); later passes sample the guide of that iteration without training.
+  // settings().guideTrainSpp and summary().guideTrainSpp become the samples trained. False (and
+  // nothing changes) elsewhere, or when training is over or the render is unguided.
+  bool endTraining();
   const RenderSettings& settings() const { return m_settings; }
   // The path tracer that traces this render's paths (tests read and write its path state).
   PathIntegrator& paths() { return *m_paths; }

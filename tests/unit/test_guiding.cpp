@@ -333,10 +333,11 @@ TEST(Guiding, SplatsRadianceFromLaterInThePathOverThroughputAndPdf) {
   const std::uint32_t n = 4;
   const std::uint32_t R = GUIDE_RECORD_VEC4S;
   std::vector<glm::vec4> rec(3 * n * R, glm::vec4(0.0f));
-  auto set = [&](int p, int k, glm::vec4 a, glm::vec4 b) {
-    rec[(p * n + k) * R] = a;
-    rec[(p * n + k) * R + 1] = b;
-    rec[(p * n + k) * R + 2] = glm::vec4(-1.0f, 0.0f, 0.0f, 0.0f);  // not a mixture vertex
+  auto set = [&](std::uint32_t p, std::uint32_t k, glm::vec4 a, glm::vec4 b) {
+    const std::uint32_t i = shared::guideRecordIndex(p, k, 3);
+    rec[i] = a;
+    rec[i + 1] = b;
+    rec[i + 2] = glm::vec4(-1.0f, 0.0f, 0.0f, 0.0f);  // not a mixture vertex
   };
   const glm::vec4 up(0, 0, 1, 0);
   set(0, 0, {0.5f, 0.5f, 0.5f, 0.0f}, up + glm::vec4(0, 0, 0, 2.0f));
@@ -375,7 +376,7 @@ TEST(Guiding, ParallelSplatsGiveTheSameTreesBitForBit) {
     const std::uint32_t len = 1 + std::uint32_t(U(rng) * (n - 1));  // vertices with a sample
     float arrival = 0.0f;
     for (std::uint32_t k = 0; k <= len && k < n; ++k) {
-      glm::vec4* r = &rec[(std::size_t(p) * n + k) * R];
+      glm::vec4* r = &rec[shared::guideRecordIndex(p, k, paths)];
       r[0] = glm::vec4(U(rng), U(rng) * U(rng), U(rng), k == 0 ? 0.0f : (U(rng) < 0.1f ? -1.0f : arrival));
       if (k == len) break;  // the path ended here: b.w = 0
       const glm::vec3 d = uniformSphere(rng);
