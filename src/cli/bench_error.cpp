@@ -204,7 +204,10 @@ std::vector<Curve> runPoint(vk::Context& ctx, const PointConfig& pc, Progress& p
                 const vec4& fo = b.fOk[r * n + i];
                 double y = 0, ye = 0;
                 if (fo.w > 0 && wp.w > 0) {
-                  y = double(luminance(vec3(fo))) * double(wp.z) / double(wp.w);
+                  // The integrand is the reflection hemisphere's, as the reference's and the other
+                  // strategies'. A transmitting model's quadtree also samples the lower side; those
+                  // samples add 0 (an unbiased estimate of the upper side's integral, not a failure).
+                  y = wp.z > 0 ? double(luminance(vec3(fo))) * double(wp.z) / double(wp.w) : 0.0;
                   ye = y * envRadiance(vec3(wp));
                 } else ++failed;
                 if (!std::isfinite(y)) { y = 0; ye = 0; ++failed; }
