@@ -76,34 +76,54 @@ SHARED_FN uvec4 guideLeafInfo(GuideView G, vec3 x) {
 
 // ---- Directions -----------------------------------------------------------------------------------
 
-// Density per unit area of the map at p in [0, 1)^2 of the quadtree rooted at `root`: the
-// product over the descent of 4 x (child's mass / node's mass). 0 where a cell has no mass or
-// the tree has none.
-SHARED_FN float guideSquarePdf(GuideView G, uint root, vec2 p) {
+// The directional quadtree's one descent, which serves both its look-up and its sampling, so that
+// a shade stage whose lanes do either (guided samples, and the guide's density at BSDF samples)
+// walks the tree once. Returns the density per unit area of the map (the product over the descent
+// of 4 x child's mass / node's mass; 0 where a cell has no mass or the tree has none) at p:
+// - draw false: p in [0, 1)^2 is given, the descent follows it;
+// - draw true: a cell is drawn in proportion to the masses (mass_descent.h: uDescent, rescaled
+//   at each level; its fresh numbers come from the stream of uDescent and uCell, rng.h) and p is
+//   set to the point uCell of that cell (a function of the numbers alone). The density returned
+//   is the cell's: the one a look-up of p gives, computed by the same operations (bit for bit).
+SHARED_FN float guideSquareDescend(GuideView G, uint root, bool draw, float uDescent, vec2 uCell, INOUT(vec2) p) {
   uint node = root;
   float x0 = 0.0f;
   float y0 = 0.0f;
   float size = 1.0f;
   float pdf = 1.0f;
+  MassDescent m = massDescentStart(uDescent);
+  uvec4 stream = rngStreamKey(uDescent, uCell.x, floatBitsToUint(uCell.y), RNG_GUIDE_STREAM);
   for (uint d = 0u; d <= GUIDE_MAX_DIR_DEPTH; ++d) {
     GuideDirNode N = GUIDE_DIR(G, node);
     float total = N.mass.x + N.mass.y + N.mass.z + N.mass.w;
     if (!(total > 0.0f)) return 0.0f;
     size *= 0.5f;
-    uint c = 0u;
-    if (p.x >= x0 + size) {
-      c += 1u;
-      x0 += size;
+    uint c;
+    if (draw) {
+      float share;
+      c = massDescendStep(N.mass, stream, m, share);
+    } else {
+      c = (p.x >= x0 + size ? 1u : 0u) + (p.y >= y0 + size ? 2u : 0u);
     }
-    if (p.y >= y0 + size) {
-      c += 2u;
-      y0 += size;
-    }
+    if ((c & 1u) != 0u) x0 += size;
+    if ((c & 2u) != 0u) y0 += size;
     pdf *= 4.0f * N.mass[c] / total;
-    if (N.child[c] == 0u) return pdf;
+    if (N.child[c] == 0u) {
+      // The point of the cell, kept below its upper edges (x0 + u size can round up to them):
+      // a look-up of p then takes this very cell.
+      if (draw)
+        p = vec2(min(x0 + uCell.x * size, uintBitsToFloat(floatBitsToUint(x0 + size) - 1u)),
+                 min(y0 + uCell.y * size, uintBitsToFloat(floatBitsToUint(y0 + size) - 1u)));
+      return pdf;
+    }
     node = N.child[c];
   }
   return 0.0f;
+}
+
+// Density per unit area of the map at p in [0, 1)^2 of the quadtree rooted at `root`.
+SHARED_FN float guideSquarePdf(GuideView G, uint root, vec2 p) {
+  return guideSquareDescend(G, root, false, 0.0f, vec2(0.0f), p);
 }
 
 // Density per steradian with which guideDirSample draws the unit direction d.
@@ -111,33 +131,13 @@ SHARED_FN float guideDirPdf(GuideView G, uint root, vec3 d) {
   return guideSquarePdf(G, root, guideDirectionToSquare(d)) * NUSSELT_INV_4PI;
 }
 
-// Draws a unit direction d (world) with density guideDirPdf from the quadtree rooted at `root`:
-// a cell by descent in proportion to the masses (mass_descent.h: uDescent, rescaled at each level;
-// its fresh numbers come from the stream of uDescent and uCell, rng.h), then a uniform point of
-// the cell (uCell). A function of its numbers alone. False when the tree has no mass.
-SHARED_FN bool guideDirSample(GuideView G, uint root, float uDescent, vec2 uCell, OUT(vec3) d) {
-  d = vec3(0.0f, 0.0f, 1.0f);
-  uint node = root;
-  float x0 = 0.0f;
-  float y0 = 0.0f;
-  float size = 1.0f;
-  MassDescent m = massDescentStart(uDescent);
-  uvec4 stream = rngStreamKey(uDescent, uCell.x, floatBitsToUint(uCell.y), RNG_GUIDE_STREAM);
-  for (uint depth = 0u; depth <= GUIDE_MAX_DIR_DEPTH; ++depth) {
-    GuideDirNode N = GUIDE_DIR(G, node);
-    float share;
-    uint c = massDescendStep(N.mass, stream, m, share);
-    if (!(share > 0.0f)) return false;
-    size *= 0.5f;
-    if ((c & 1u) != 0u) x0 += size;
-    if ((c & 2u) != 0u) y0 += size;
-    if (N.child[c] == 0u) {
-      d = guideSquareToDirection(vec2(x0 + uCell.x * size, y0 + uCell.y * size));
-      return true;
-    }
-    node = N.child[c];
-  }
-  return false;
+// Draws a unit direction d (world) with density guideDirPdf from the quadtree rooted at `root`
+// (guideSquareDescend). pdf: the density per steradian of its cell. False when the tree has no mass.
+SHARED_FN bool guideDirSample(GuideView G, uint root, float uDescent, vec2 uCell, OUT(vec3) d, OUT(float) pdf) {
+  vec2 p = vec2(0.0f);
+  pdf = guideSquareDescend(G, root, true, uDescent, uCell, p) * NUSSELT_INV_4PI;
+  d = pdf > 0.0f ? guideSquareToDirection(p) : vec3(0.0f, 0.0f, 1.0f);
+  return pdf > 0.0f;
 }
 
 // ---- One-sample MIS with the BRDF sampler ---------------------------------------------------------
@@ -171,26 +171,22 @@ GuideVertex guideVertex(vec3 x) {
   return v;
 }
 
-// The guide's density per steradian at the world direction w in region v (0 where it has no mass).
-float guideDensity(GuideVertex v, vec3 w) { return guideDirPdf(g.guide.v[0], v.root, w); }
-
 // The mixture's density for the world direction w whose BRDF-sampler density is pdfBsdf.
 float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) {
   if (!(v.alpha > 0.0f)) return pdfBsdf;
   return guideMixturePdf(v.alpha, guideDirPdf(g.guide.v[0], v.root, w), pdfBsdf);
 }
 
-// A direction from the guide of region v, in the local frame (t, b, n) of the shading point:
-// uDescent = the tree descent's number; the point in the cell comes from the bounce's
-// RNG_DIM_GUIDE_CELL. False (the path ends) when the region has no mass or the direction lies
-// below the surface, where f cos = 0: the mixture's density still counts the guide's share there.
-bool guideSampleLocal(GuideVertex v, float uDescent, PathKey k, uint bounce, vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
-  wiLocal = vec3(0.0f, 0.0f, 1.0f);
+// The guide's descent at a vertex of region v (guideSquareDescend): guided, a direction drawn from
+// the guide (w set; uDescent = the descent's number, the point in its cell from the bounce's
+// RNG_DIM_GUIDE_CELL); otherwise the look-up of the given world direction w. Returns the guide's
+// density per steradian at w (0: the region has no mass there; a guided sample then fails).
+float guideDescend(GuideVertex v, bool guided, float uDescent, PathKey k, uint bounce, inout vec3 w) {
   vec2 uCell = pathSample2(k, rngDimension(bounce, RNG_DIM_GUIDE_CELL));
-  vec3 w;
-  if (!guideDirSample(g.guide.v[0], v.root, uDescent, uCell, w)) return false;
-  wiLocal = toLocal(w, t, b, n);
-  return wiLocal.z > 0.0f;
+  vec2 p = guided ? vec2(0.0f) : guideDirectionToSquare(w);
+  float pdf = guideSquareDescend(g.guide.v[0], v.root, guided, uDescent, uCell, p) * NUSSELT_INV_4PI;
+  if (guided && pdf > 0.0f) w = guideSquareToDirection(p);
+  return pdf;
 }
 
 // Whether this pass writes training records (the guide's info.x).
@@ -256,12 +252,8 @@ void guideRecordSample(uint path, uint bounce, vec3 wi, float value, vec3 select
 #else
 // A module without guiding (NUSSELT_SCENE_FEATURES 0, stage_common.glsl): empty stand-ins.
 GuideVertex guideVertex(vec3 x) { return GuideVertex(0u, 0.0f); }
-float guideDensity(GuideVertex v, vec3 w) { return 0.0f; }
 float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) { return pdfBsdf; }
-bool guideSampleLocal(GuideVertex v, float uDescent, PathKey k, uint bounce, vec3 t, vec3 b, vec3 n, out vec3 wiLocal) {
-  wiLocal = vec3(0.0f, 0.0f, 1.0f);
-  return false;
-}
+float guideDescend(GuideVertex v, bool guided, float uDescent, PathKey k, uint bounce, inout vec3 w) { return 0.0f; }
 bool guideRecording() { return false; }
 bool guidePhotons() { return false; }
 void guideRecordPhoton(uint path, uint bounce, vec3 x, vec3 wFrom, float value) {}

@@ -1,6 +1,6 @@
 // mass_descent.h: descending a tree of four-child nodes in proportion to their masses, with one
 // uniform number, shared by the quadtree sampler (quadtree.h, quadDescend) and the path guide's
-// directional trees (guiding.h, guideDirSample). The trees differ in how a node is read and what a
+// directional trees (guiding.h, guideSquareDescend). The trees differ in how a node is read and what a
 // child link means; the step below is what they have in common: the choice of a child, the
 // rescaling of the number, and the fresh numbers that take over when it runs out of resolution.
 #ifndef NUSSELT_MASS_DESCENT_H

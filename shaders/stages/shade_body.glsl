@@ -312,19 +312,24 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
   vec2 uG = vec2(1.0f);
   if (GUIDING && m.gv.alpha > 0.0f) uG = pathSample2(k, rngDimension(bounce, RNG_DIM_GUIDE));
   bool guided = GUIDING && uG.x < m.gv.alpha;
-  if (guided) {
-    if (!guideSampleLocal(m.gv, uG.y, k, bounce, tt, bb, ns, wiLocal)) return false;
-    weight = brdfEval(MODEL_ID, m.M.params, wiLocal, wo) * wiLocal.z;  // f cos, over the mixture below
-    pdf = 1.0f;
-    q = 1.0f;
-  } else if (!shadeBsdfSample(m, wo, inside, uB, wiLocal, weight, pdf, q))
-    return false;
+  if (!guided && !shadeBsdfSample(m, wo, inside, uB, wiLocal, weight, pdf, q)) return false;
   // Training records need both densities wherever the guide could be chosen, also where alpha is
   // 0 (the trainer estimates from them what another alpha would do: GuideTree::observeSelection).
   bool record = GUIDING && !modelIsDelta(MODEL_ID) && guideRecording();
   if (GUIDING && (m.gv.alpha > 0.0f || record)) {
+    // One descent of the guide's tree for every lane: a guided lane draws its direction, the
+    // others look up the guide's density at their BSDF sample (guiding.h, guideDescend).
+    vec3 w = guided ? vec3(0.0f) : toWorld(wiLocal, tt, bb, ns);
+    float pdfG = guideDescend(m.gv, guided, uG.y, k, bounce, w);
+    if (guided) {
+      if (!(pdfG > 0.0f)) return false;
+      wiLocal = toLocal(w, tt, bb, ns);
+      if (!(wiLocal.z > 0.0f)) return false;  // below the surface, f cos = 0: the path ends
+      weight = brdfEval(MODEL_ID, m.M.params, wiLocal, wo) * wiLocal.z;  // f cos, over the mixture below
+      pdf = 1.0f;
+      q = 1.0f;
+    }
     float pdfB = guided ? shadeBsdfPdf(m, wo, wiLocal) : pdf;
-    float pdfG = guideDensity(m.gv, toWorld(wiLocal, tt, bb, ns));
     s.selection = vec3(pdfG, pdfB, m.gv.alpha);
     if (m.gv.alpha > 0.0f) {
       // The mixture's density, for the weight f cos / pdf and for MIS at the next hit.

@@ -182,19 +182,26 @@ TEST_P(GuidingFloor, SamplingMatchesPdfChiSquare) {
   std::vector<double> observed(g * g, 0.0);
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> U(0.0f, 1.0f);
-  int failed = 0;
+  int failed = 0, pdfDiffers = 0;
   for (int i = 0; i < N; ++i) {
     shared::vec3 d;
+    float pdf;
     float u = std::min(U(rng), NUSSELT_ONE_MINUS_EPS);
     shared::vec2 uc(std::min(U(rng), NUSSELT_ONE_MINUS_EPS), std::min(U(rng), NUSSELT_ONE_MINUS_EPS));
-    if (!shared::guideDirSample(f.view, root, u, uc, d)) {
+    if (!shared::guideDirSample(f.view, root, u, uc, d, pdf)) {
       ++failed;
       continue;
     }
+    // The sample's density is its cell's: the look-up of its map point gives it bit for bit (the
+    // shade stage takes it instead of a second descent).
+    shared::vec2 q(0.0f);
+    const float pSquare = shared::guideSquareDescend(f.view, root, true, u, uc, q);
+    if (pSquare != shared::guideSquarePdf(f.view, root, q) || pdf != pSquare * NUSSELT_INV_4PI) ++pdfDiffers;
     shared::vec2 p = shared::guideDirectionToSquare(d);
     observed[int(p.y * g) * g + int(p.x * g)] += 1;
   }
   EXPECT_EQ(failed, 0);
+  EXPECT_EQ(pdfDiffers, 0);
   // Pool bins below 5 expected; significance 0.01.
   double chi2 = 0, poolE = 0, poolO = 0;
   int dof = -1;
