@@ -17,7 +17,7 @@
 //
 // Shape of the loop (lavapipe truncates loops after 65,535 iterations per invocation, so keep
 // the iteration count low and the loops simple): one iteration per inner node visited. Each
-// iteration tests both child boxes of the node, intersects leaf children on the spot (<= 8
+// iteration tests both child boxes of the node, intersects leaf children on the spot (<= 32
 // triangles each), then descends into the nearer inner child, deferring the farther one on a
 // fixed-size stack. The stack holds at most one node per level and the builder caps the depth
 // at BVH_STACK_SIZE - 2, so it cannot overflow; if it ever did, the overflow is counted and the

@@ -21,9 +21,16 @@ using shared::BvhNode;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 // SAH bins per axis: 32 is within a percent or two of a full sweep on typical meshes.
 constexpr int kBins = 32;
-// Cost of visiting one node relative to testing one triangle. A node visit tests two boxes and
-// fetches 80 bytes, a triangle test fetches 48 bytes and does a few cross products: roughly even.
-constexpr float kTraversalCost = 1.0f;
+// Cost of visiting one node relative to testing one triangle, as the GLSL traversal runs on a CPU
+// device (the BVH's users: --traversal auto takes ray queries on GPUs). By the arithmetic alone a
+// node visit (two boxes, 80 bytes) and a triangle test (48 bytes, a few cross products) are about
+// even, but on lavapipe a visit is an iteration of a loop whose lanes diverge (stack, nearer
+// child, the leaf loops), where a leaf's triangles are tested by every lane in step. Measured
+// (bench render, 3 interleaved repeats; docs/performance.md): 4 with leaves of up to 32 triangles
+// against 1 with leaves of up to 8 gives the Cornell boxes (32 triangles: one node, two leaves)
+// 1.25x the samples/s, the dragon (100k), the materials scene (44k) and the glass box (5k) the
+// same within the repeats' spread.
+constexpr float kTraversalCost = 4.0f;
 // Subtrees at least this large are built on their own thread (below that a thread costs more
 // than it saves).
 constexpr std::uint32_t kParallelMinTriangles = 32 * 1024;

@@ -28,7 +28,7 @@
 namespace nusselt {
 
 // Leaves never hold more triangles than this: the GPU leaf loop is bounded by it.
-constexpr std::uint32_t kBvhMaxLeafSize = 8;
+constexpr std::uint32_t kBvhMaxLeafSize = 32;
 // The deepest leaf allowed (see above).
 constexpr std::uint32_t kBvhMaxDepth = BVH_STACK_SIZE - 2;
 
