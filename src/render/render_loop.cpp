@@ -76,7 +76,7 @@ bool RenderLoop::step() {
 // (lavapipe) and the photon pre-pass.
 void RenderLoop::planTraining() {
   const std::uint32_t trained = m_renderer.guideTrainedSpp();
-  if (trained == m_iterationEndSpp || ((trained + 1) & trained) != 0) return;  // mid-iteration, or seen
+  if (trained == m_iterationEndSpp || !guideIterationEnds(trained)) return;  // mid-iteration, or seen
   if (trained >= guideTrainingSpp(m_renderer.settings())) return;              // the training is over
   const double now = seconds(), last = now - m_iterationEndSeconds;
   m_iterationEndSpp = trained;

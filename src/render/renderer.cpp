@@ -272,7 +272,7 @@ void Renderer::renderPass(std::uint32_t samples) {
 bool Renderer::endTraining() {
   if (!m_guide) return false;
   const std::uint32_t trained = m_guideSamples;
-  if (trained < 1 || trained >= guideTrainingSpp(m_settings) || ((trained + 1) & trained) != 0) return false;
+  if (!guideIterationEnds(trained) || trained >= guideTrainingSpp(m_settings)) return false;
   m_settings.guideTrainSpp = trained;
   m_summary.guideTrainSpp = trained;
   m_guide->setRecording(false);

@@ -242,6 +242,10 @@ inline std::uint32_t guideTrainingSpp(const RenderSettings& s) {
   return t;
 }
 
+// Whether `trained` samples per pixel end a training iteration: iteration k covers the samples
+// [2^k - 1, 2^(k+1) - 1), so its end is 2^(k+1) - 1 (0 ends none).
+inline bool guideIterationEnds(std::uint32_t trained) { return trained > 0 && ((trained + 1) & trained) == 0; }
+
 // What the stages counted, summed over passes: one field per entry of NUSSELT_STATS (layout.h).
 struct RenderStats {
 #define NUSSELT_STAT_FIELD(ID, index, name, what) std::uint64_t name = 0;
