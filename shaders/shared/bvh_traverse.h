@@ -100,6 +100,15 @@ SHARED_FN BvhRay bvhMakeRay(vec3 origin, vec3 dir) {
   return r;
 }
 
+// Whether a ray can be traced: finite origin and direction. A NaN or infinite component (a broken
+// shading frame upstream) makes the slab tests' distances NaN, which max/min may drop (LLVM's
+// maxnum returns the other operand), so such a ray would enter every box, the inverted box of an
+// empty slot included, and follow its invalid link. It hits nothing instead.
+SHARED_FN bool bvhRayFinite(vec3 origin, vec3 dir) {
+  return isFinite(origin.x) && isFinite(origin.y) && isFinite(origin.z) && isFinite(dir.x) && isFinite(dir.y) &&
+         isFinite(dir.z);
+}
+
 // Slab test. The entry plane is chosen by the sign of the direction rather than as the min of
 // both plane distances: an inverted box (the empty slot, min = +inf, max = -inf) then gives
 // entry = +inf > exit = -inf and is never entered, where min/max would report (-inf, +inf).
@@ -172,7 +181,7 @@ SHARED_FN bool traceClosest(vec3 origin, vec3 dir, float tmin, float tmax, OUT(f
   b2 = 0.0f;
   tri = INVALID_INDEX;
   BVH_LOCALS
-  if (BVH_EMPTY()) return false;
+  if (BVH_EMPTY() || !bvhRayFinite(origin, dir)) return false;
   BvhRay ray = bvhMakeRay(origin, dir);
   uint stack[BVH_STACK_SIZE];
   uint sp = 0u;
@@ -217,7 +226,7 @@ SHARED_FN bool traceClosest(vec3 origin, vec3 dir, float tmin, float tmax, OUT(f
 // visited in stored order: with no closest hit to shrink the interval, sorting buys nothing.
 SHARED_FN bool traceAny(vec3 origin, vec3 dir, float tmin, float tmax) {
   BVH_LOCALS
-  if (BVH_EMPTY()) return false;
+  if (BVH_EMPTY() || !bvhRayFinite(origin, dir)) return false;
   BvhRay ray = bvhMakeRay(origin, dir);
   uint stack[BVH_STACK_SIZE];
   uint sp = 0u;
