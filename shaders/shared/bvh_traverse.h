@@ -104,9 +104,11 @@ SHARED_FN BvhRay bvhMakeRay(vec3 origin, vec3 dir) {
 // shading frame upstream) makes the slab tests' distances NaN, which max/min may drop (LLVM's
 // maxnum returns the other operand), so such a ray would enter every box, the inverted box of an
 // empty slot included, and follow its invalid link. It hits nothing instead.
+// Branch-free (a chain of short-circuit tests costs lavapipe branches per ray): a float is finite
+// when its exponent bits are not all ones.
 SHARED_FN bool bvhRayFinite(vec3 origin, vec3 dir) {
-  return isFinite(origin.x) && isFinite(origin.y) && isFinite(origin.z) && isFinite(dir.x) && isFinite(dir.y) &&
-         isFinite(dir.z);
+  uvec3 e = max(floatBitsToUint(origin) & uvec3(0x7f800000u), floatBitsToUint(dir) & uvec3(0x7f800000u));
+  return all(lessThan(e, uvec3(0x7f800000u)));
 }
 
 // Slab test. The entry plane is chosen by the sign of the direction rather than as the min of
