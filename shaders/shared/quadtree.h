@@ -173,6 +173,51 @@ SHARED_FN float quadMixturePdf(QuadSet S, uint model, BrdfParams p, uvec4 idx, v
   return (1.0f - eps) * sum * wc.z + eps * wc.z * NUSSELT_INV_PI;
 }
 
+// quadMixturePdf for a direction the sampler drew from the tree of corner `chosen` (c = 0 .. 3 as
+// there: bit 0 the second theta table, bit 1 the second phi table; 4: from the defensive cosine),
+// whose luminance fl = f(wc, v_k) (at wc's mirror image: the same value, f being symmetric) the
+// rejection already evaluated: f is evaluated at the other corners only. A lane's other corners
+// are found by index, so a subgroup evaluates f once per other corner (isotropic sets: once),
+// whichever corner each lane drew from; only lanes that drew the defensive cosine evaluate the
+// chosen corner's f too, in a branch that the other lanes skip.
+SHARED_FN float quadMixturePdfKnown(QuadSet S, uint model, BrdfParams p, uvec4 idx, vec2 ts, float eps, vec3 wc,
+                                    uint chosen, float fl) {
+  bool transmits = (S.info.w & QT_SET_TRANSMITS) != 0u;
+  if (wc.z <= 0.0f && !(transmits && wc.z < 0.0f)) return 0.0f;
+  uint np = S.info.z;
+  uint lower = S.info.x + S.info.y * np;  // first lower-disc table (transmitting sets)
+  uint known = chosen < 4u ? chosen : 0u;
+  float sum = 0.0f;
+  for (uint i = 0u; i < 3u; ++i) {
+    uint c = i < known ? i : i + 1u;
+    float wt = ((c & 1u) != 0u ? ts.x : 1.0f - ts.x) * ((c & 2u) != 0u ? ts.y : 1.0f - ts.y);
+    if (wt <= 0.0f) continue;
+    uint k = (c & 1u) != 0u ? idx.y : idx.x;
+    uint j = (c & 2u) != 0u ? idx.w : idx.z;
+    QuadTable T = QT_TABLE(S.info.x + k * np + j);
+    float mass = T.data.x;
+    if (transmits) mass += QT_TABLE(lower + k * np + j).data.x;
+    if (mass <= 0.0f) continue;
+    sum += wt * quadEvalLum(model, p, wc, quadTableDirection(T)) / mass;
+  }
+  {
+    uint c = known;
+    float wt = ((c & 1u) != 0u ? ts.x : 1.0f - ts.x) * ((c & 2u) != 0u ? ts.y : 1.0f - ts.y);
+    uint k = (c & 1u) != 0u ? idx.y : idx.x;
+    uint j = (c & 2u) != 0u ? idx.w : idx.z;
+    QuadTable T = QT_TABLE(S.info.x + k * np + j);
+    float mass = T.data.x;
+    if (transmits) mass += QT_TABLE(lower + k * np + j).data.x;
+    if (wt > 0.0f && mass > 0.0f) {
+      float f = fl;
+      if (chosen >= 4u) f = quadEvalLum(model, p, wc, quadTableDirection(T));
+      sum += wt * f / mass;
+    }
+  }
+  if (transmits) return (1.0f - eps) * sum * abs(wc.z) + eps * abs(wc.z) * (0.5f * NUSSELT_INV_PI);
+  return (1.0f - eps) * sum * wc.z + eps * wc.z * NUSSELT_INV_PI;
+}
+
 // ---- Public interface ---------------------------------------------------------------------------
 
 // Density per unit solid angle with which quadSample draws w for the known direction v (both in
@@ -436,6 +481,8 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, OU
   bool transmits = (S.info.w & QT_SET_TRANSMITS) != 0u;
   float massAll = 0.0f;  // a_up + a_low of the chosen table (transmitting sets)
   float uy = u.y;
+  uint chosen = 4u;  // the corner of the chosen tree (quadMixturePdfKnown); 4: the defensive cosine
+  float fl = 0.0f;   // the luminance of f(wc, v_k) there
   if (uy < eps) {
     if (transmits) {  // a cosine on either side, 1/2 each
       bool below = u.x >= 0.5f;
@@ -447,10 +494,11 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, OU
   } else {
     uy = (uy - eps) / (1.0f - eps);
     uint k = idx.x;
-    if (uy >= 1.0f - ts.x) { k = idx.y; uy = (uy - (1.0f - ts.x)) / ts.x; }
+    chosen = 0u;
+    if (uy >= 1.0f - ts.x) { k = idx.y; uy = (uy - (1.0f - ts.x)) / ts.x; chosen = 1u; }
     else uy = uy / (1.0f - ts.x);
     uint j = idx.z;
-    if (uy >= 1.0f - ts.y) j = idx.w;
+    if (uy >= 1.0f - ts.y) { j = idx.w; chosen |= 2u; }
     QuadTable T = QT_TABLE(S.info.x + k * np + j);
     vec3 vk = quadTableDirection(T);
     // Transmitting sets: the lower disc with probability a_low / (a_up + a_low), by what is left of uy.
@@ -475,7 +523,6 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, OU
     uvec4 base = rngStreamKey(u.x, u.y, 0u, RNG_REJECTION_STREAM);
     QuadDescent d;
     if (!quadDescend(T.info.x, aniso, u.x, uvec4(base.x, base.y, base.z ^ 0x5bd1e995u, base.w), d)) return false;
-    float fl;
     if (!quadLeafSample(model, p, vk, d, base, side, wc, fl)) return false;
     if (eps == 0.0f && ts.x == 0.0f && ts.y == 0.0f) {
       // On a table: one component, pdf = f(w, v_k) |cos| / a_k (transmitting: a_up + a_low) with
@@ -488,7 +535,7 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, OU
     }
   }
   w = quadFromCanonical(fr, wc);
-  pdf = quadMixturePdf(S, model, p, idx, ts, eps, wc);
+  pdf = quadMixturePdfKnown(S, model, p, idx, ts, eps, wc, chosen, fl);
   f = brdfEval(model, p, w, v);
   return pdf > 0.0f;
 }

@@ -293,6 +293,9 @@ int sampleCommand(const SampleArgs& a) {
   std::printf("bound violations %llu, trial failures %llu, failed samples %llu\n",
               static_cast<unsigned long long>(b.boundViolations), static_cast<unsigned long long>(b.trialFailures),
               static_cast<unsigned long long>(failed));
+  if (strategy == SAMPLER_QUADTREE && a.cpu && a.n > 0)
+    std::printf("per sample: %.3f rejection trials, %.3f evaluations of f in the trials, %.2f inner nodes read\n",
+                double(b.trials) / a.n, double(b.evaluations) / a.n, double(b.nodeReads) / a.n);
   if (!a.svg.empty()) {
     const QuadSet& s = tables.sets[setIndex[0]];
     std::uint32_t k = std::min<std::uint32_t>(std::uint32_t(std::lround(th / s.data.y)), s.info.y - 1);
