@@ -148,6 +148,31 @@ SHARED_FN float quadEvalLum(uint model, BrdfParams p, vec3 w, vec3 v) {
   return isFinite(f) ? max(f, 0.0f) : 0.0f;
 }
 
+// Corner c (bit 0: the second theta table idx.y, bit 1: the second phi table idx.w) of the mixture
+// between tables: its weight, and its table with mass = a_up (+ a_low for transmitting sets).
+SHARED_FN float quadCornerWeight(vec2 ts, uint c) {
+  return ((c & 1u) != 0u ? ts.x : 1.0f - ts.x) * ((c & 2u) != 0u ? ts.y : 1.0f - ts.y);
+}
+SHARED_FN QuadTable quadCornerTable(QuadSet S, uvec4 idx, uint c, OUT(float) mass) {
+  uint np = S.info.z;
+  uint k = (c & 1u) != 0u ? idx.y : idx.x;
+  uint j = (c & 2u) != 0u ? idx.w : idx.z;
+  QuadTable T = QT_TABLE(S.info.x + k * np + j);
+  mass = T.data.x;
+  if ((S.info.w & QT_SET_TRANSMITS) != 0u) mass += QT_TABLE(S.info.x + S.info.y * np + k * np + j).data.x;
+  return T;
+}
+
+// Corner c's term of the mixture's sum at wc: weight f(wc, v_c) / mass (0 without weight or mass).
+SHARED_FN float quadCornerTerm(QuadSet S, uint model, BrdfParams p, uvec4 idx, vec2 ts, vec3 wc, uint c) {
+  float wt = quadCornerWeight(ts, c);
+  if (wt <= 0.0f) return 0.0f;
+  float mass;
+  QuadTable T = quadCornerTable(S, idx, c, mass);
+  if (mass <= 0.0f) return 0.0f;
+  return wt * quadEvalLum(model, p, wc, quadTableDirection(T)) / mass;
+}
+
 // Solid-angle density of the mixture at the canonical direction wc (wc.z > 0): the (bi)linear
 // mixture of the neighbouring trees, plus eps cos / pi when the direction is between tables.
 // Transmitting sets (QT_SET_TRANSMITS): wc on either side, each tree pair's density
@@ -155,20 +180,8 @@ SHARED_FN float quadEvalLum(uint model, BrdfParams p, vec3 w, vec3 v) {
 SHARED_FN float quadMixturePdf(QuadSet S, uint model, BrdfParams p, uvec4 idx, vec2 ts, float eps, vec3 wc) {
   bool transmits = (S.info.w & QT_SET_TRANSMITS) != 0u;
   if (wc.z <= 0.0f && !(transmits && wc.z < 0.0f)) return 0.0f;
-  uint np = S.info.z;
-  uint lower = S.info.x + S.info.y * np;  // first lower-disc table (transmitting sets)
   float sum = 0.0f;
-  for (uint c = 0u; c < 4u; ++c) {
-    float wt = ((c & 1u) != 0u ? ts.x : 1.0f - ts.x) * ((c & 2u) != 0u ? ts.y : 1.0f - ts.y);
-    if (wt <= 0.0f) continue;
-    uint k = (c & 1u) != 0u ? idx.y : idx.x;
-    uint j = (c & 2u) != 0u ? idx.w : idx.z;
-    QuadTable T = QT_TABLE(S.info.x + k * np + j);
-    float mass = T.data.x;
-    if (transmits) mass += QT_TABLE(lower + k * np + j).data.x;
-    if (mass <= 0.0f) continue;
-    sum += wt * quadEvalLum(model, p, wc, quadTableDirection(T)) / mass;
-  }
+  for (uint c = 0u; c < 4u; ++c) sum += quadCornerTerm(S, model, p, idx, ts, wc, c);
   if (transmits) return (1.0f - eps) * sum * abs(wc.z) + eps * abs(wc.z) * (0.5f * NUSSELT_INV_PI);
   return (1.0f - eps) * sum * wc.z + eps * wc.z * NUSSELT_INV_PI;
 }
@@ -184,30 +197,13 @@ SHARED_FN float quadMixturePdfKnown(QuadSet S, uint model, BrdfParams p, uvec4 i
                                     uint chosen, float fl) {
   bool transmits = (S.info.w & QT_SET_TRANSMITS) != 0u;
   if (wc.z <= 0.0f && !(transmits && wc.z < 0.0f)) return 0.0f;
-  uint np = S.info.z;
-  uint lower = S.info.x + S.info.y * np;  // first lower-disc table (transmitting sets)
   uint known = chosen < 4u ? chosen : 0u;
   float sum = 0.0f;
-  for (uint i = 0u; i < 3u; ++i) {
-    uint c = i < known ? i : i + 1u;
-    float wt = ((c & 1u) != 0u ? ts.x : 1.0f - ts.x) * ((c & 2u) != 0u ? ts.y : 1.0f - ts.y);
-    if (wt <= 0.0f) continue;
-    uint k = (c & 1u) != 0u ? idx.y : idx.x;
-    uint j = (c & 2u) != 0u ? idx.w : idx.z;
-    QuadTable T = QT_TABLE(S.info.x + k * np + j);
-    float mass = T.data.x;
-    if (transmits) mass += QT_TABLE(lower + k * np + j).data.x;
-    if (mass <= 0.0f) continue;
-    sum += wt * quadEvalLum(model, p, wc, quadTableDirection(T)) / mass;
-  }
+  for (uint i = 0u; i < 3u; ++i) sum += quadCornerTerm(S, model, p, idx, ts, wc, i < known ? i : i + 1u);
   {
-    uint c = known;
-    float wt = ((c & 1u) != 0u ? ts.x : 1.0f - ts.x) * ((c & 2u) != 0u ? ts.y : 1.0f - ts.y);
-    uint k = (c & 1u) != 0u ? idx.y : idx.x;
-    uint j = (c & 2u) != 0u ? idx.w : idx.z;
-    QuadTable T = QT_TABLE(S.info.x + k * np + j);
-    float mass = T.data.x;
-    if (transmits) mass += QT_TABLE(lower + k * np + j).data.x;
+    float wt = quadCornerWeight(ts, known);
+    float mass;
+    QuadTable T = quadCornerTable(S, idx, known, mass);
     if (wt > 0.0f && mass > 0.0f) {
       float f = fl;
       if (chosen >= 4u) f = quadEvalLum(model, p, wc, quadTableDirection(T));
