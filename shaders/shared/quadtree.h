@@ -153,13 +153,18 @@ SHARED_FN float quadEvalLum(uint model, BrdfParams p, vec3 w, vec3 v) {
 SHARED_FN float quadCornerWeight(vec2 ts, uint c) {
   return ((c & 1u) != 0u ? ts.x : 1.0f - ts.x) * ((c & 2u) != 0u ? ts.y : 1.0f - ts.y);
 }
-SHARED_FN QuadTable quadCornerTable(QuadSet S, uvec4 idx, uint c, OUT(float) mass) {
-  uint np = S.info.z;
+// The index of corner c's (upper) table; a transmitting set's lower table is S.info.y * S.info.z
+// further.
+SHARED_FN uint quadCornerIndex(QuadSet S, uvec4 idx, uint c) {
   uint k = (c & 1u) != 0u ? idx.y : idx.x;
   uint j = (c & 2u) != 0u ? idx.w : idx.z;
-  QuadTable T = QT_TABLE(S.info.x + k * np + j);
+  return S.info.x + k * S.info.z + j;
+}
+SHARED_FN QuadTable quadCornerTable(QuadSet S, uvec4 idx, uint c, OUT(float) mass) {
+  uint i = quadCornerIndex(S, idx, c);
+  QuadTable T = QT_TABLE(i);
   mass = T.data.x;
-  if ((S.info.w & QT_SET_TRANSMITS) != 0u) mass += QT_TABLE(S.info.x + S.info.y * np + k * np + j).data.x;
+  if ((S.info.w & QT_SET_TRANSMITS) != 0u) mass += QT_TABLE(i + S.info.y * S.info.z).data.x;
   return T;
 }
 
@@ -489,20 +494,19 @@ SHARED_FN bool quadSample(uint set, uint model, BrdfParams p, vec3 v, vec2 u, OU
     }
   } else {
     uy = (uy - eps) / (1.0f - eps);
-    uint k = idx.x;
     chosen = 0u;
-    if (uy >= 1.0f - ts.x) { k = idx.y; uy = (uy - (1.0f - ts.x)) / ts.x; chosen = 1u; }
+    if (uy >= 1.0f - ts.x) { uy = (uy - (1.0f - ts.x)) / ts.x; chosen = 1u; }
     else uy = uy / (1.0f - ts.x);
-    uint j = idx.z;
-    if (uy >= 1.0f - ts.y) { j = idx.w; chosen |= 2u; }
-    QuadTable T = QT_TABLE(S.info.x + k * np + j);
+    if (uy >= 1.0f - ts.y) chosen |= 2u;
+    uint ti = quadCornerIndex(S, idx, chosen);
+    QuadTable T = QT_TABLE(ti);
     vec3 vk = quadTableDirection(T);
     // Transmitting sets: the lower disc with probability a_low / (a_up + a_low), by what is left of uy.
     float side = 1.0f;
     massAll = T.data.x;
     if (transmits) {
       uy = uy >= 1.0f - ts.y ? (uy - (1.0f - ts.y)) / ts.y : uy / (1.0f - ts.y);
-      QuadTable L = QT_TABLE(S.info.x + S.info.y * np + k * np + j);
+      QuadTable L = QT_TABLE(ti + S.info.y * np);
       massAll = T.data.x + L.data.x;
       if (L.data.x > 0.0f && uy * massAll >= T.data.x) {
         T = L;
