@@ -21,7 +21,8 @@
 // triangles each), then descends into the nearer inner child, deferring the farther one on a
 // fixed-size stack. The stack holds at most one node per level and the builder caps the depth
 // at BVH_STACK_SIZE - 2, so it cannot overflow; if it ever did, the overflow is counted and the
-// traversal stops with what it found.
+// traversal stops with what it found. When a whole subgroup tests one leaf, its lanes share the
+// loads of its triangles (bvhLeafShared below; docs/performance.md, "Shared leaf loads").
 
 #ifndef NUSSELT_BVH_TRAVERSE_H
 #define NUSSELT_BVH_TRAVERSE_H
@@ -141,35 +142,101 @@ SHARED_FN bool bvhHitTriangle(vec3 origin, vec3 dir, GpuTriangle tri, float tmin
   return det != 0.0f && b1 >= 0.0f && b2 >= 0.0f && b1 + b2 <= 1.0f && t > tmin && t < tmax;
 }
 
+// Triangle i (data T) of a leaf: if it is hit nearer than t and passes, it replaces the hit record.
+SHARED_FN void bvhClosestStep(vec3 origin, vec3 dir, GpuTriangle T, uint i, float tmin, INOUT(float) t,
+                              INOUT(float) b1, INOUT(float) b2, INOUT(uint) tri, INOUT(bool) found) {
+  BVH_LOCALS
+  float tt;
+  float u;
+  float v;
+  if (bvhHitTriangle(origin, dir, T, tmin, t, tt, u, v) && BVH_PASSES(i, u, v, origin, dir)) {
+    t = tt;
+    b1 = u;
+    b2 = v;
+    tri = i;
+    found = true;
+  }
+}
+
+// Whether triangle i (data T) is hit in (tmin, tmax) and passes.
+SHARED_FN bool bvhAnyStep(vec3 origin, vec3 dir, GpuTriangle T, uint i, float tmin, float tmax) {
+  BVH_LOCALS
+  float tt;
+  float u;
+  float v;
+  return bvhHitTriangle(origin, dir, T, tmin, tmax, tt, u, v) && BVH_PASSES(i, u, v, origin, dir);
+}
+
+// The GLSL traversal shares the loads of leaves (below); the tests' trace_tool_lanes module
+// (-DNUSSELT_BVH_PER_LANE) does not, to check that both find the same hits bit for bit.
+#if !defined(__cplusplus) && !defined(NUSSELT_BVH_PER_LANE)
+#define BVH_SHARED_LEAVES 1
+#else
+#define BVH_SHARED_LEAVES 0
+#endif
+
+#if BVH_SHARED_LEAVES
+// Shared leaves. A load through a buffer reference costs each lane its own access (on lavapipe a
+// scalar load per lane and component, with a mask test: ~500 instructions per triangle for 8
+// lanes, where its test is ~40). When every lane of the subgroup tests the same leaf (a small
+// scene, coherent rays), lane l loads triangle base + l of the leaf instead and the lanes hand the
+// triangles round with subgroupShuffle (one vpermd per component on lavapipe): a batch of
+// gl_SubgroupSize triangles for one load per lane. Each lane still tests the triangles of its leaf
+// in the same order with the same data, so the hits are bit for bit those of the plain loop.
+bool bvhLeafShared(uint first) {
+  return subgroupBallotBitCount(subgroupBallot(first == subgroupBroadcastFirst(first))) == gl_SubgroupSize;
+}
+GpuTriangle bvhShuffleTriangle(GpuTriangle L, uint k) {
+  GpuTriangle T;
+  T.v0 = vec4(subgroupShuffle(L.v0.xyz, k), 0.0f);
+  T.e1 = vec4(subgroupShuffle(L.e1.xyz, k), 0.0f);
+  T.e2 = vec4(subgroupShuffle(L.e2.xyz, k), 0.0f);
+  return T;
+}
+#endif
+
 // The triangles [first, first + count) of a leaf: the nearest that passes, with t < the current
 // t, replaces the hit record.
 SHARED_FN void bvhLeafClosest(vec3 origin, vec3 dir, uint first, uint count, float tmin, INOUT(float) t,
                               INOUT(float) b1, INOUT(float) b2, INOUT(uint) tri, INOUT(bool) found) {
   BVH_LOCALS
-  for (uint i = first; i < first + count; ++i) {
-    float tt;
-    float u;
-    float v;
-    if (bvhHitTriangle(origin, dir, BVH_TRIANGLE(i), tmin, t, tt, u, v) && BVH_PASSES(i, u, v, origin, dir)) {
-      t = tt;
-      b1 = u;
-      b2 = v;
-      tri = i;
-      found = true;
+#if BVH_SHARED_LEAVES
+  if (bvhLeafShared(first)) {
+    for (uint base = 0u; base < count; base += gl_SubgroupSize) {
+      GpuTriangle L = BVH_TRIANGLE(first + min(base + gl_SubgroupInvocationID, count - 1u));
+      uint n = min(gl_SubgroupSize, count - base);
+      for (uint k = 0u; k < n; ++k)
+        bvhClosestStep(origin, dir, bvhShuffleTriangle(L, k), first + base + k, tmin, t, b1, b2, tri, found);
     }
+  } else
+#endif
+  {
+    for (uint i = first; i < first + count; ++i)
+      bvhClosestStep(origin, dir, BVH_TRIANGLE(i), i, tmin, t, b1, b2, tri, found);
   }
 }
 
 // Whether a triangle of [first, first + count) is hit in (tmin, tmax) and passes.
 SHARED_FN bool bvhLeafAny(vec3 origin, vec3 dir, uint first, uint count, float tmin, float tmax) {
   BVH_LOCALS
-  for (uint i = first; i < first + count; ++i) {
-    float tt;
-    float u;
-    float v;
-    if (bvhHitTriangle(origin, dir, BVH_TRIANGLE(i), tmin, tmax, tt, u, v) && BVH_PASSES(i, u, v, origin, dir))
-      return true;
+#if BVH_SHARED_LEAVES
+  if (bvhLeafShared(first)) {
+    // Every lane stays in the loops (a lane that left would not load its share of the next
+    // batch); a lane that has found its hit skips the tests, and the batches stop once all have.
+    bool hit = false;
+    for (uint base = 0u; base < count && !subgroupAll(hit); base += gl_SubgroupSize) {
+      GpuTriangle L = BVH_TRIANGLE(first + min(base + gl_SubgroupInvocationID, count - 1u));
+      uint n = min(gl_SubgroupSize, count - base);
+      for (uint k = 0u; k < n; ++k) {
+        GpuTriangle T = bvhShuffleTriangle(L, k);
+        if (!hit) hit = bvhAnyStep(origin, dir, T, first + base + k, tmin, tmax);
+      }
+    }
+    return hit;
   }
+#endif
+  for (uint i = first; i < first + count; ++i)
+    if (bvhAnyStep(origin, dir, BVH_TRIANGLE(i), i, tmin, tmax)) return true;
   return false;
 }
 

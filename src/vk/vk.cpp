@@ -185,9 +185,11 @@ DeviceInfo describe(VkPhysicalDevice pd, std::uint32_t index, std::uint32_t* que
   p2.pNext = &sub;
   vkGetPhysicalDeviceProperties2(pd, &p2);
   info.driverInfo = std::string(driver.driverName) + (driver.driverInfo[0] ? std::string(" ") + driver.driverInfo : "");
-  VkSubgroupFeatureFlags need = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT;
+  // Ballot, vote and shuffle: the queues' allocation, the quadtree sampler, the BVH's shared leaves.
+  VkSubgroupFeatureFlags need = VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_BALLOT_BIT |
+                                VK_SUBGROUP_FEATURE_VOTE_BIT | VK_SUBGROUP_FEATURE_SHUFFLE_BIT;
   if (!(sub.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) || (sub.supportedOperations & need) != need) {
-    info.whyNot = "lacks subgroup ballot in compute shaders";
+    info.whyNot = "lacks subgroup ballot, vote or shuffle in compute shaders";
     return info;
   }
   info.suitable = true;

@@ -1,7 +1,8 @@
 // test_traversal.cpp: the ray-query traversal against the GLSL BVH as its oracle (stage trace_tool
 // compiled both ways, shaders/shared/trace.glsl): on the same random rays, the same closest hits
 // (triangle, t, barycentrics within float tolerances) and the same any-hit answers, on the Cornell
-// box and the 100k-triangle dragon; and the fallback to the BVH on a device without ray queries.
+// box and the 100k-triangle dragon; the BVH's shared leaf loads against per-lane loads (the same
+// hits bit for bit); and the fallback to the BVH on a device without ray queries.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -242,9 +243,74 @@ void compareTraversals(const std::string& relative, std::uint32_t n, std::uint32
 
 }  // namespace
 
+// Bundles of 8 rays (a subgroup on lavapipe) from one random point of the scene's box (inflated by
+// 10 %), with directions within ~3 degrees of one uniform direction: coherent rays, which visit
+// the same leaves, as the camera's and the light's rays of a small scene do.
+std::vector<Ray> bundleRays(const Scene& scene, std::uint32_t n, std::uint32_t seed) {
+  glm::vec3 lo(INFINITY), hi(-INFINITY);
+  for (const glm::vec3& p : scene.positions) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  glm::vec3 c = 0.5f * (lo + hi), h = 0.55f * (hi - lo);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  std::normal_distribution<float> g(0.0f, 1.0f);
+  std::vector<Ray> rays(n);
+  glm::vec3 o(0.0f), axis(0.0f, 0.0f, 1.0f);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    if (i % 8 == 0) {
+      o = c + h * glm::vec3(2 * u(rng) - 1, 2 * u(rng) - 1, 2 * u(rng) - 1);
+      axis = glm::normalize(glm::vec3(g(rng), g(rng), g(rng)) + glm::vec3(1e-6f));
+    }
+    glm::vec3 d = glm::normalize(axis + 0.05f * glm::vec3(g(rng), g(rng), g(rng)));
+    rays[i] = {o, d, 3.0e38f};
+  }
+  return rays;
+}
+
+// The GLSL BVH with its shared leaf loads (trace_tool) against the same traversal with every lane
+// loading its own triangles (trace_tool_lanes): both must find the same hits bit for bit, closest
+// and any, on random rays and on coherent bundles (which take the shared loads).
+void compareLeafLoads(const std::string& relative, std::uint32_t n, std::uint32_t seed) {
+  vk::Context& ctx = test::context();
+  Scene scene = test::loadTestScene(relative);
+  TraversalStructures bvhOnly;
+  bvhOnly.bvh = true;
+  bvhOnly.accelerationStructures = false;
+  DeviceScene device(ctx, scene, bvhOnly);
+  std::vector<Ray> rays = randomRays(scene, n, seed);
+  const std::vector<Ray> bundles = bundleRays(scene, n, seed + 1);
+  rays.insert(rays.end(), bundles.begin(), bundles.end());
+  const std::vector<Hit> shared = trace(ctx, device, rays, "trace_tool");
+  const std::vector<Hit> lanes = trace(ctx, device, rays, "trace_tool_lanes");
+  std::uint32_t differ = 0, bundleHits = 0, bundleMisses = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const Hit &a = shared[i], &b = lanes[i];
+    const bool same = a.closest == b.closest && a.any == b.any && a.tri == b.tri &&
+                      std::memcmp(&a.t, &b.t, sizeof a.t) == 0 && std::memcmp(&a.b1, &b.b1, sizeof a.b1) == 0 &&
+                      std::memcmp(&a.b2, &b.b2, sizeof a.b2) == 0;
+    if (!same && ++differ <= 10)
+      ADD_FAILURE() << relative << " ray " << i << (i >= n ? " (bundle)" : "") << ": shared loads "
+                    << (a.closest ? "hit triangle " + std::to_string(a.tri) + " at t " + std::to_string(a.t) : "miss")
+                    << " (any " << a.any << "), per-lane loads "
+                    << (b.closest ? "hit triangle " + std::to_string(b.tri) + " at t " + std::to_string(b.t) : "miss")
+                    << " (any " << b.any << ")";
+    if (i >= n) (a.closest ? bundleHits : bundleMisses)++;
+  }
+  std::printf("%s: %zu rays (%u in bundles: %u hits, %u misses), %u differ\n", relative.c_str(), rays.size(), n,
+              bundleHits, bundleMisses, differ);
+  EXPECT_EQ(differ, 0u);
+  EXPECT_GT(bundleHits, n / 4);  // not vacuous
+}
+
 TEST(Traversal, RayQueryMatchesBvhCornellBox) { compareTraversals("scenes/cornell-box.glb", 240000, 21u); }
 
 TEST(Traversal, RayQueryMatchesBvhDragon) { compareTraversals("scenes/dragon/dragon.gltf", 240000, 22u); }
+
+TEST(Traversal, SharedLeafLoadsMatchPerLaneLoadsCornellBox) { compareLeafLoads("scenes/cornell-box.glb", 120000, 23u); }
+
+TEST(Traversal, SharedLeafLoadsMatchPerLaneLoadsDragon) { compareLeafLoads("scenes/dragon/dragon.gltf", 120000, 24u); }
 
 // A device without ray queries (Mesa 22.3's lavapipe; here: a context that does not enable them)
 // renders with the BVH under auto, and refuses --traversal rayquery with a clear message.
