@@ -46,19 +46,26 @@ struct Hit {
   std::uint32_t tri = INVALID_INDEX;
 };
 
+// The scene's bounding box, inflated by 10 %: its centre c and half extents h; its diagonal.
+float inflatedBox(const Scene& scene, glm::vec3& c, glm::vec3& h) {
+  glm::vec3 lo(INFINITY), hi(-INFINITY);
+  for (const glm::vec3& p : scene.positions) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  c = 0.5f * (lo + hi);
+  h = 0.55f * (hi - lo);
+  return glm::length(hi - lo);
+}
+
 // Three kinds of rays with the scene's bounding box B (inflated by 10 %): from random points in B
 // in uniform directions (unbounded: closest hit or escape), segments between two random points of
 // B (bounded: shadow rays through the scene), and rays leaving random points of random triangles
 // (offset along the normal by 1e-4 of the scene size) into the hemisphere of that normal, as the
 // path tracer's bounces do.
 std::vector<Ray> randomRays(const Scene& scene, std::uint32_t n, std::uint32_t seed) {
-  glm::vec3 lo(INFINITY), hi(-INFINITY);
-  for (const glm::vec3& p : scene.positions) {
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  glm::vec3 c = 0.5f * (lo + hi), h = 0.55f * (hi - lo);
-  const float size = glm::length(hi - lo);
+  glm::vec3 c, h;
+  const float size = inflatedBox(scene, c, h);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   std::normal_distribution<float> g(0.0f, 1.0f);
@@ -247,12 +254,8 @@ void compareTraversals(const std::string& relative, std::uint32_t n, std::uint32
 // 10 %), with directions within ~3 degrees of one uniform direction: coherent rays, which visit
 // the same leaves, as the camera's and the light's rays of a small scene do.
 std::vector<Ray> bundleRays(const Scene& scene, std::uint32_t n, std::uint32_t seed) {
-  glm::vec3 lo(INFINITY), hi(-INFINITY);
-  for (const glm::vec3& p : scene.positions) {
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  glm::vec3 c = 0.5f * (lo + hi), h = 0.55f * (hi - lo);
+  glm::vec3 c, h;
+  inflatedBox(scene, c, h);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   std::normal_distribution<float> g(0.0f, 1.0f);
