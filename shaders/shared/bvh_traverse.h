@@ -177,8 +177,8 @@ SHARED_FN bool bvhAnyStep(vec3 origin, vec3 dir, GpuTriangle T, uint i, float tm
 
 #if BVH_SHARED_LEAVES
 // Shared leaves. A load through a buffer reference costs each lane its own access (on lavapipe a
-// scalar load per lane and component, with a mask test: ~500 instructions per triangle for 8
-// lanes, where its test is ~40). When every lane of the subgroup tests the same leaf (a small
+// scalar load per lane and component behind a mask test: 72 for one triangle and 8 lanes, where
+// its test is ~40 vector instructions). When every lane of the subgroup tests the same leaf (a small
 // scene, coherent rays), lane l loads triangle base + l of the leaf instead and the lanes hand the
 // triangles round with subgroupShuffle (one vpermd per component on lavapipe): a batch of
 // gl_SubgroupSize triangles for one load per lane. Each lane still tests the triangles of its leaf
