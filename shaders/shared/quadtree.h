@@ -178,6 +178,14 @@ SHARED_FN float quadCornerTerm(QuadSet S, uint model, BrdfParams p, uvec4 idx, v
   return wt * quadEvalLum(model, p, wc, quadTableDirection(T)) / mass;
 }
 
+// The mixture's density at wc from the sum over its corners of w_c f(wc, v_c) / mass: (1 - eps)
+// sum |cos| plus the defensive cosine's eps |cos| / pi (transmitting sets: eps |cos| / (2 pi), a
+// cosine on either side).
+SHARED_FN float quadMixtureFromSum(bool transmits, float sum, float eps, vec3 wc) {
+  if (transmits) return (1.0f - eps) * sum * abs(wc.z) + eps * abs(wc.z) * (0.5f * NUSSELT_INV_PI);
+  return (1.0f - eps) * sum * wc.z + eps * wc.z * NUSSELT_INV_PI;
+}
+
 // Solid-angle density of the mixture at the canonical direction wc (wc.z > 0): the (bi)linear
 // mixture of the neighbouring trees, plus eps cos / pi when the direction is between tables.
 // Transmitting sets (QT_SET_TRANSMITS): wc on either side, each tree pair's density
@@ -187,8 +195,7 @@ SHARED_FN float quadMixturePdf(QuadSet S, uint model, BrdfParams p, uvec4 idx, v
   if (wc.z <= 0.0f && !(transmits && wc.z < 0.0f)) return 0.0f;
   float sum = 0.0f;
   for (uint c = 0u; c < 4u; ++c) sum += quadCornerTerm(S, model, p, idx, ts, wc, c);
-  if (transmits) return (1.0f - eps) * sum * abs(wc.z) + eps * abs(wc.z) * (0.5f * NUSSELT_INV_PI);
-  return (1.0f - eps) * sum * wc.z + eps * wc.z * NUSSELT_INV_PI;
+  return quadMixtureFromSum(transmits, sum, eps, wc);
 }
 
 // quadMixturePdf for a direction the sampler drew from the tree of corner `chosen` (c = 0 .. 3 as
@@ -215,8 +222,7 @@ SHARED_FN float quadMixturePdfKnown(QuadSet S, uint model, BrdfParams p, uvec4 i
       sum += wt * f / mass;
     }
   }
-  if (transmits) return (1.0f - eps) * sum * abs(wc.z) + eps * abs(wc.z) * (0.5f * NUSSELT_INV_PI);
-  return (1.0f - eps) * sum * wc.z + eps * wc.z * NUSSELT_INV_PI;
+  return quadMixtureFromSum(transmits, sum, eps, wc);
 }
 
 // ---- Public interface ---------------------------------------------------------------------------
