@@ -64,8 +64,8 @@ SHARED_END
   BvhNodes bvhNodes = g.bvh; \
   Triangles bvhTriangles = g.triangles;
 #define BVH_EMPTY() (g.triangleCount == 0u)
-#define BVH_NODE(i) (bvhNodes.v[i])
-#define BVH_TRIANGLE(i) (bvhTriangles.v[i])
+#define BVH_NODE(i) loadBvhNode(bvhNodes, i)
+#define BVH_TRIANGLE(i) loadTriangle(bvhTriangles, i)
 #define BVH_PASSES(i, b1, b2, origin, dir) (!HAS_ALPHA || alphaPasses(i, b1, b2, origin, dir))
 #define BVH_COUNT_STACK_OVERFLOW() atomicAdd(g.stats.v[STAT_BVH_STACK_OVERFLOW], 1u)
 #endif
@@ -177,8 +177,8 @@ SHARED_FN bool bvhAnyStep(vec3 origin, vec3 dir, GpuTriangle T, uint i, float tm
 
 #if BVH_SHARED_LEAVES
 // Shared leaves. A load through a buffer reference costs each lane its own access (on lavapipe a
-// scalar load per lane and component behind a mask test: 72 for one triangle and 8 lanes, where
-// its test is ~40 vector instructions). When every lane of the subgroup tests the same leaf (a small
+// scalar load per lane and 64-bit half behind a mask test, layout.h "64-bit loads": 48 for one
+// triangle and 8 lanes, where its test is ~40 vector instructions). When every lane of the subgroup tests the same leaf (a small
 // scene, coherent rays), lane l loads triangle base + l of the leaf instead and the lanes hand the
 // triangles round with subgroupShuffle (one vpermd per component on lavapipe): a batch of
 // gl_SubgroupSize triangles for one load per lane. Each lane still tests the triangles of its leaf

@@ -245,6 +245,85 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer TabTables {
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Textures { GpuTexture v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer MaterialTextures { GpuMaterialTextures v[]; };
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer TriTexcoords { GpuTriTexcoords v[]; };
+
+// ---- 64-bit loads and stores (docs/performance.md, "64-bit loads") ----
+// lavapipe performs a load or store through a buffer reference whose address may differ between
+// lanes as one scalar access per lane and component (LLVM scalarises the masked gather on CPUs
+// without fast gathers: a mask test, a branch, an address extraction, the load and an insert for
+// each). A vec4 read as two 64-bit components costs half the accesses of four 32-bit ones; on a GPU
+// both are one 16-byte access. The hot per-lane accesses of the stages (path state, BVH nodes,
+// triangles, shading data, materials) go through the functions below; the layouts are unchanged.
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer Wide { u64vec2 v[]; };
+vec4 wideVec4(u64vec2 a) { return uintBitsToFloat(uvec4(unpackUint2x32(a.x), unpackUint2x32(a.y))); }
+uvec4 wideUVec4(u64vec2 a) { return uvec4(unpackUint2x32(a.x), unpackUint2x32(a.y)); }
+u64vec2 wideBits(uvec4 v) { return u64vec2(packUint2x32(v.xy), packUint2x32(v.zw)); }
+u64vec2 wideBits(vec4 v) { return wideBits(floatBitsToUint(v)); }
+
+// Macros, so that they take members of the readonly globals block (a function parameter would
+// drop the qualifier). b: any buffer reference whose elements are 16-byte aligned.
+#define loadVec4(b, i) wideVec4(Wide(b).v[i])
+#define loadUVec4(b, i) wideUVec4(Wide(b).v[i])
+#define storeVec4(b, i, value) (Wide(b).v[i] = wideBits(value))
+#define storeUVec4(b, i, value) (Wide(b).v[i] = wideBits(value))
+#define loadBvhNode(b, i) wideBvhNode(Wide(b), i)
+#define loadTriangle(b, i) wideTriangle(Wide(b), i)
+#define loadTriShading(b, i) wideTriShading(Wide(b), i)
+#define loadMaterial(b, i) wideMaterial(Wide(b), i)
+#define loadLight(b, i) wideLight(Wide(b), i)
+#define loadQuadNode(b, i) wideQuadNode(Wide(b), i)
+#define loadQuadLeaf(b, i) wideQuadLeaf(Wide(b), i)
+#define loadQuadTable(b, i) wideQuadTable(Wide(b), i)
+#define loadQuadSet(b, i) wideQuadSet(Wide(b), i)
+BvhNode wideBvhNode(Wide w, uint i) {
+  BvhNode n;
+  n.min0 = wideVec4(w.v[5u * i]);
+  n.max0 = wideVec4(w.v[5u * i + 1u]);
+  n.min1 = wideVec4(w.v[5u * i + 2u]);
+  n.max1 = wideVec4(w.v[5u * i + 3u]);
+  n.link = wideUVec4(w.v[5u * i + 4u]);
+  return n;
+}
+GpuTriangle wideTriangle(Wide w, uint i) {
+  GpuTriangle t;
+  t.v0 = wideVec4(w.v[3u * i]);
+  t.e1 = wideVec4(w.v[3u * i + 1u]);
+  t.e2 = wideVec4(w.v[3u * i + 2u]);
+  return t;
+}
+GpuTriShading wideTriShading(Wide w, uint i) {
+  GpuTriShading s;
+  s.n0 = wideVec4(w.v[4u * i]);
+  s.n1 = wideVec4(w.v[4u * i + 1u]);
+  s.n2 = wideVec4(w.v[4u * i + 2u]);
+  s.info = wideUVec4(w.v[4u * i + 3u]);
+  return s;
+}
+GpuLight wideLight(Wide w, uint i) {
+  GpuLight l;
+  l.info = wideUVec4(w.v[5u * i]);
+  l.position = wideVec4(w.v[5u * i + 1u]);
+  l.direction = wideVec4(w.v[5u * i + 2u]);
+  l.intensity = wideVec4(w.v[5u * i + 3u]);
+  l.cone = wideVec4(w.v[5u * i + 4u]);
+  return l;
+}
+QuadNode wideQuadNode(Wide w, uint i) { return QuadNode(wideVec4(w.v[2u * i]), wideUVec4(w.v[2u * i + 1u])); }
+QuadLeaf wideQuadLeaf(Wide w, uint i) {
+  return QuadLeaf(wideVec4(w.v[3u * i]), wideVec4(w.v[3u * i + 1u]), wideVec4(w.v[3u * i + 2u]));
+}
+QuadTable wideQuadTable(Wide w, uint i) { return QuadTable(wideUVec4(w.v[2u * i]), wideVec4(w.v[2u * i + 1u])); }
+QuadSet wideQuadSet(Wide w, uint i) { return QuadSet(wideUVec4(w.v[2u * i]), wideVec4(w.v[2u * i + 1u])); }
+GpuMaterial wideMaterial(Wide w, uint i) {
+  uint o = 12u * i;
+  GpuMaterial m;
+  m.info = wideUVec4(w.v[o]);
+  m.emission = wideVec4(w.v[o + 1u]);
+  for (uint k = 0u; k < BRDF_PARAM_VEC4S; ++k) m.params.v[k] = wideVec4(w.v[o + 2u + k]);
+  m.components = wideUVec4(w.v[o + 2u + BRDF_PARAM_VEC4S]);
+  m.absorption = wideVec4(w.v[o + 3u + BRDF_PARAM_VEC4S]);
+  return m;
+}
 #endif
 
 // The environment: an equirectangular (lat-long) radiance map and its sampling distribution

@@ -220,7 +220,7 @@ vec3 offsetRay(vec3 p, vec3 n) {
 // ---- Triangles ------------------------------------------------------------------------------
 
 vec3 triangleNormalUnnormalized(uint tri) {
-  GpuTriangle t = g.triangles.v[tri];
+  GpuTriangle t = loadTriangle(g.triangles, tri);
   return cross(t.e1.xyz, t.e2.xyz);
 }
 
@@ -287,11 +287,11 @@ bool sampleLight(vec3 x, float uSelect, vec2 uPoint, out LightSample ls) {
   uint li = selectLight(uSelect);
   float pSelect = lightSelectPdf(li);
   if (pSelect <= 0.0f) return false;
-  GpuLight light = g.lights.v[li];
+  GpuLight light = loadLight(g.lights, li);
   uint type = light.info.x;
   if (type == LIGHT_TRIANGLE) {
     uint tri = light.info.y;
-    GpuTriangle t = g.triangles.v[tri];
+    GpuTriangle t = loadTriangle(g.triangles, tri);
     vec2 b = squareToTriangle(uPoint);
     vec3 y = t.v0.xyz + b.x * t.e1.xyz + b.y * t.e2.xyz;
     vec3 nu = cross(t.e1.xyz, t.e2.xyz);

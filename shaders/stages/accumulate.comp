@@ -14,7 +14,7 @@ void main() {
   vec4 sum = g.film.v[pixel];
   vec4 sumSq = g.filmSq.v[pixel];
   for (uint j = i; j < g.chunkPaths && (g.chunkFirst + j) / g.passSamples == pixel; ++j) {
-    vec3 L = g.pathRadiance.v[j].xyz;
+    vec3 L = loadVec4(g.pathRadiance, j).xyz;
     if (!(isFinite(L.x) && isFinite(L.y) && isFinite(L.z))) {
       atomicAdd(g.stats.v[STAT_NONFINITE_SAMPLES], 1u);
       L = vec3(0.0f);

@@ -41,11 +41,11 @@ void main() {
     dir = normalize(g.camForward.xyz + sx * g.camRight.xyz + sy * g.camUp.xyz);
   }
 
-  g.pathOrigin.v[i] = vec4(origin, 0.0f);
-  g.pathDirection.v[i] = vec4(dir, 0.0f);  // w = 0: no BSDF pdf yet (camera ray)
-  g.pathThroughput.v[i] = vec4(1.0f, 1.0f, 1.0f, 1.0f);  // w: etaScale
-  g.pathRadiance.v[i] = vec4(0.0f);
-  g.pathInfo.v[i] = uvec4(pixel, sampleIndex, 0u, 0u);
+  storeVec4(g.pathOrigin, i, vec4(origin, 0.0f));
+  storeVec4(g.pathDirection, i, vec4(dir, 0.0f));  // w = 0: no BSDF pdf yet (camera ray)
+  storeVec4(g.pathThroughput, i, vec4(1.0f, 1.0f, 1.0f, 1.0f));  // w: etaScale
+  storeVec4(g.pathRadiance, i, vec4(0.0f));
+  storeUVec4(g.pathInfo, i, uvec4(pixel, sampleIndex, 0u, 0u));
   if (GUIDING) guideRecordStart(i);  // a training pass's first record (guiding.h)
   g.queues.v[QUEUE_HEADER_UINTS + QUEUE_RAY0 * g.pathCapacity + i] = i;
   if (i == 0u) {

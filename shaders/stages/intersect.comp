@@ -24,14 +24,14 @@ void traceRay(uint queue, uint idx) {
   }
   uint path = queueItem(queue, idx);
 
-  vec3 o = g.pathOrigin.v[path].xyz;
-  vec3 d = g.pathDirection.v[path].xyz;
+  vec3 o = loadVec4(g.pathOrigin, path).xyz;
+  vec3 d = loadVec4(g.pathDirection, path).xyz;
   float t;
   float b1;
   float b2;
   uint tri;
   if (traceClosest(o, d, 0.0f, 3.0e38f, t, b1, b2, tri)) {
-    g.pathHit.v[path] = vec4(t, b1, b2, uintBitsToFloat(tri));
+    storeVec4(g.pathHit, path, vec4(t, b1, b2, uintBitsToFloat(tri)));
     uint material = g.shading.v[tri].info.x;
     queuePush(QUEUE_SHADE_BASE + g.materials.v[material].info.w, path);
   } else if (g.environmentLight != INVALID_INDEX) {
@@ -44,9 +44,12 @@ void traceShadow(uint queue, uint idx) {
   if (idx >= count) return;
   if (idx == 0u) atomicAdd(g.stats.v[STAT_SHADOW_RAYS], count);
   uint path = queueItem(queue, idx);
-  vec4 o = g.shadowOrigin.v[path];
-  vec3 d = g.shadowDirection.v[path].xyz;
-  if (!traceAny(o.xyz, d, 0.0f, o.w)) g.pathRadiance.v[path].xyz += g.shadowRadiance.v[path].xyz;
+  vec4 o = loadVec4(g.shadowOrigin, path);
+  vec3 d = loadVec4(g.shadowDirection, path).xyz;
+  if (!traceAny(o.xyz, d, 0.0f, o.w)) {
+    vec4 R = loadVec4(g.pathRadiance, path);
+    storeVec4(g.pathRadiance, path, vec4(R.xyz + loadVec4(g.shadowRadiance, path).xyz, R.w));
+  }
 }
 
 void main() {

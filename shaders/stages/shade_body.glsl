@@ -582,9 +582,9 @@ void nextEvent(ShadeMaterial m, uint path, PathKey k, uint bounce, uint lighting
     if (max(c.x, max(c.y, c.z)) > 0.0f) {
       // Stop short of the light so that the emitter itself never occludes.
       float tmax = ls.dist < 1.0e38f ? ls.dist * (1.0f - 1e-4f) : ls.dist;
-      g.shadowOrigin.v[path] = vec4(behind ? offsetRay(x, -ng) : xo, tmax);
-      g.shadowDirection.v[path] = vec4(ls.wi, 0.0f);
-      g.shadowRadiance.v[path] = vec4(c, 0.0f);
+      storeVec4(g.shadowOrigin, path, vec4(behind ? offsetRay(x, -ng) : xo, tmax));
+      storeVec4(g.shadowDirection, path, vec4(ls.wi, 0.0f));
+      storeVec4(g.shadowRadiance, path, vec4(c, 0.0f));
       queuePush(QUEUE_SHADOW0 + (bounce & 1u), path);
     }
   }
@@ -609,9 +609,9 @@ void continuePath(PathStep s, uint path, uint bounce, uint roulette, vec3 x, vec
   }
   if (GUIDING && !guidePhotons())
     guideRecordSample(path, bounce, wi, s.delta ? -1.0f : luminance(beta) * s.pdf, s.selection);
-  g.pathOrigin.v[path] = vec4(xo, 0.0f);
-  g.pathDirection.v[path] = vec4(wi, s.pdf);
-  g.pathThroughput.v[path] = vec4(beta, etaScale);
+  storeVec4(g.pathOrigin, path, vec4(xo, 0.0f));
+  storeVec4(g.pathDirection, path, vec4(wi, s.pdf));
+  storeVec4(g.pathThroughput, path, vec4(beta, etaScale));
   queuePush(((bounce + 1u) & 1u), path);
 }
 
@@ -629,18 +629,17 @@ void main() {
   uint roulette = g.roulette;
 
   // ---- Hit geometry ----
-  vec4 hit = g.pathHit.v[path];
+  vec4 hit = loadVec4(g.pathHit, path);
   uint tri = floatBitsToUint(hit.w);
-  vec3 rayO = g.pathOrigin.v[path].xyz;
-  vec4 rayD = g.pathDirection.v[path];
+  vec4 rayD = loadVec4(g.pathDirection, path);
   vec3 dir = rayD.xyz;
   float prevPdf = rayD.w;
-  GpuTriangle T = g.triangles.v[tri];
-  GpuTriShading S = g.shading.v[tri];
+  GpuTriangle T = loadTriangle(g.triangles, tri);
+  GpuTriShading S = loadTriShading(g.shading, tri);
   vec3 x = T.v0.xyz + hit.y * T.e1.xyz + hit.z * T.e2.xyz;
   vec3 ngFront = normalize(cross(T.e1.xyz, T.e2.xyz));
   vec3 ns = normalize((1.0f - hit.y - hit.z) * S.n0.xyz + hit.y * S.n1.xyz + hit.z * S.n2.xyz);
-  GpuMaterial M = g.materials.v[S.info.x];
+  GpuMaterial M = loadMaterial(g.materials, S.info.x);
   // evalParams: the parameters and emission at this point (differ from M's only where textured).
   vec3 Le = M.emission.xyz;
 #if SHADE_COMBINED
@@ -649,7 +648,7 @@ void main() {
   if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) evalParams(MODEL_ID, S.info.x, tri, hit.y, hit.z, M.params, Le);
 #endif
   if (HAS_TEXTURES && (M.info.y & MATERIAL_TEXTURED) != 0u) ns = normalMapped(S.info.x, tri, hit.y, hit.z, ns, ngFront);
-  vec4 throughput = g.pathThroughput.v[path];
+  vec4 throughput = loadVec4(g.pathThroughput, path);
   vec3 beta = throughput.xyz;
   float etaScale = throughput.w;
   vec3 L = vec3(0.0f);
@@ -707,7 +706,10 @@ void main() {
   if (!last && !photon && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m) && radiancePartKeeps(part, bounce + 1u))
     nextEvent(m, path, key, bounce, lighting, x, xo, ng, tt, bb, ns, wo, beta);
 
-  g.pathRadiance.v[path].xyz += L;
+  if (L != vec3(0.0f)) {
+    vec4 R = loadVec4(g.pathRadiance, path);
+    storeVec4(g.pathRadiance, path, vec4(R.xyz + L, R.w));
+  }
   if (last) return;
 
   // ---- The next step of the random walk: the material's sample, then the roulette ----

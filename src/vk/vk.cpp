@@ -178,6 +178,10 @@ DeviceInfo describe(VkPhysicalDevice pd, std::uint32_t index, std::uint32_t* que
     info.whyNot = "lacks scalarBlockLayout";
     return info;
   }
+  if (!f2.features.shaderInt64) {
+    info.whyNot = "lacks shaderInt64";
+    return info;
+  }
   VkPhysicalDeviceSubgroupProperties sub{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
   VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
   sub.pNext = &driver;
@@ -341,6 +345,7 @@ void createContext(Context& ctx, const ContextOptions& options) {
   f12.bufferDeviceAddress = VK_TRUE;
   f12.scalarBlockLayout = VK_TRUE;
   VkPhysicalDeviceFeatures2 f2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+  f2.features.shaderInt64 = VK_TRUE;
   f2.pNext = &f12;
   std::vector<const char*> extensions;
   if (options.swapchain) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
