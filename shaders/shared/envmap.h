@@ -41,7 +41,7 @@ SHARED_END
 #define EnvView GpuEnvironment
 #define ENV_INFO(E) (E.info)
 #define ENV_ROTATION(E) (E.rotation)
-#define ENV_TEXEL(E, i) (E.texels.v[i])
+#define ENV_TEXEL(E, i) loadVec4(E.texels, i)  // 64-bit loads (layout.h)
 #define ENV_DIST(E) (E.distribution)
 #endif
 

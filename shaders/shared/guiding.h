@@ -26,8 +26,10 @@ SHARED_END
 #else
 #define GuideView GpuGuide
 #define GUIDE_VIEW_INFO(G) (G)
-#define GUIDE_SPATIAL(G, i) (G.spatial.v[i])
-#define GUIDE_DIR(G, i) (G.dir.v[i])
+// 64-bit loads (layout.h): the descents read a node per lane.
+#define GUIDE_SPATIAL(G, i) GuideSpatialNode(loadUVec4(G.spatial, i))
+#define GUIDE_DIR(G, i) guideDirNode(Wide(G.dir), i)
+GuideDirNode guideDirNode(Wide w, uint i) { return GuideDirNode(wideVec4(w.v[2u * i]), wideUVec4(w.v[2u * i + 1u])); }
 #endif
 
 SHARED_BEGIN
@@ -205,8 +207,8 @@ void guideRecordPhoton(uint path, uint bounce, vec3 x, vec3 wFrom, float value) 
   if (bounce >= n) return;
   GuideRecords R = g.guide.v[0].records;
   uint i = guideRecordIndex(path, bounce, g.chunkPaths);
-  R.v[i] = vec4(x, value);
-  R.v[i + 1u] = vec4(wFrom, 1.0f);
+  storeVec4(R, i, vec4(x, value));
+  storeVec4(R, i + 1u, vec4(wFrom, 1.0f));
 }
 
 // A camera path's first record reads "ended at vertex 0" until a stage writes its arrival there
@@ -216,7 +218,7 @@ void guideRecordPhoton(uint path, uint bounce, vec3 x, vec3 wFrom, float value) 
 void guideRecordStart(uint path) {
   if (g.guide.v[0].info.x == 0u) return;
   GuideRecords R = g.guide.v[0].records;
-  R.v[guideRecordIndex(path, 0u, g.chunkPaths) + 1u] = vec4(0.0f);
+  storeVec4(R, guideRecordIndex(path, 0u, g.chunkPaths) + 1u, vec4(0.0f));
 }
 
 // Training record k = bounce of this path (guiding_layout.h): its ray arrived at x with the path
@@ -227,8 +229,8 @@ void guideRecordArrival(uint path, uint bounce, vec3 x) {
   if (bounce >= n) return;
   GuideRecords R = g.guide.v[0].records;
   uint i = guideRecordIndex(path, bounce, g.chunkPaths);
-  R.v[i] = vec4(x, luminance(g.pathRadiance.v[path].xyz));
-  R.v[i + 1u] = vec4(0.0f);
+  storeVec4(R, i, vec4(x, luminance(loadVec4(g.pathRadiance, path).xyz)));
+  storeVec4(R, i + 1u, vec4(0.0f));
 }
 
 // The path goes on from vertex `bounce` in the world direction wi; value = luminance of the new
@@ -241,12 +243,12 @@ void guideRecordSample(uint path, uint bounce, vec3 wi, float value, vec3 select
   if (bounce >= n) return;
   GuideRecords R = g.guide.v[0].records;
   uint i = guideRecordIndex(path, bounce, g.chunkPaths);
-  R.v[i + 1u] = vec4(wi, value > 0.0f ? value : -1.0f);  // 0 would read as "ended here"
-  R.v[i + 2u] = vec4(selection, 0.0f);
+  storeVec4(R, i + 1u, vec4(wi, value > 0.0f ? value : -1.0f));  // 0 would read as "ended here"
+  storeVec4(R, i + 2u, vec4(selection, 0.0f));
   if (bounce + 1u < n) {
     uint j = guideRecordIndex(path, bounce + 1u, g.chunkPaths);
-    R.v[j] = vec4(0.0f, 0.0f, 0.0f, -1.0f);
-    R.v[j + 1u] = vec4(0.0f);
+    storeVec4(R, j, vec4(0.0f, 0.0f, 0.0f, -1.0f));
+    storeVec4(R, j + 1u, vec4(0.0f));
   }
 }
 #else

@@ -58,7 +58,7 @@ struct PathKey {
 };
 
 PathKey pathKey(uint path) {
-  uvec4 info = g.pathInfo.v[path];
+  uvec4 info = loadUVec4(g.pathInfo, path);
   return PathKey(g.rngMode, info.x, info.y, g.seed, path);
 }
 

@@ -15,7 +15,7 @@ void main() {
   uint path = queueItem(QUEUE_ESCAPE, idx);
   if (GUIDING && guidePhotons()) return;  // a photon that left the scene: nothing to record
   if (GUIDING) guideRecordArrival(path, pc.bounce, vec3(0.0f));  // training record (guiding.h)
-  vec4 rayD = g.pathDirection.v[path];
+  vec4 rayD = loadVec4(g.pathDirection, path);
   vec3 dir = rayD.xyz;
   float prevPdf = rayD.w;
   GpuEnvironment E = g.environment.v[0];
@@ -31,7 +31,8 @@ void main() {
     }
   }
   if (w > 0.0f && radiancePartKeeps(g.radiancePart, pc.bounce)) {
-    vec3 beta = g.pathThroughput.v[path].xyz;
-    g.pathRadiance.v[path].xyz += beta * envRadiance(E, dir) * w;
+    vec3 beta = loadVec4(g.pathThroughput, path).xyz;
+    vec4 R = loadVec4(g.pathRadiance, path);
+    storeVec4(g.pathRadiance, path, vec4(R.xyz + beta * envRadiance(E, dir) * w, R.w));
   }
 }
