@@ -84,6 +84,28 @@ SHARED_BEGIN
 // test already decides arbitrarily.
 #define BVH_MIN_DIRECTION 1e-30f
 
+// The boxes and links of a stored node (layout.h, BvhNode): bound = origin + h * 2^(E - 127). The
+// product is exact (a power of two times a half, kept above the float's normal range by the
+// builder), so a fused multiply-add gives the same bits, and the builder's check of its rounding
+// (encodeBvhNode) holds for this code in both builds.
+SHARED_FN BvhNodeBoxes bvhDecodeNode(BvhNode n) {
+  vec3 o = vec3(uintBitsToFloat(n.origin.x), uintBitsToFloat(n.origin.y), uintBitsToFloat(n.origin.z));
+  float s = uintBitsToFloat((n.origin.w & 0xffu) << 23);
+  vec2 a = unpackHalf2x16(n.child0.x);
+  vec2 b = unpackHalf2x16(n.child0.y);
+  vec2 c = unpackHalf2x16(n.child0.z);
+  BvhNodeBoxes r;
+  r.min0 = vec4(o + vec3(a.x, a.y, b.x) * s, 0.0f);
+  r.max0 = vec4(o + vec3(b.y, c.x, c.y) * s, 0.0f);
+  a = unpackHalf2x16(n.child1.x);
+  b = unpackHalf2x16(n.child1.y);
+  c = unpackHalf2x16(n.child1.z);
+  r.min1 = vec4(o + vec3(a.x, a.y, b.x) * s, 0.0f);
+  r.max1 = vec4(o + vec3(b.y, c.x, c.y) * s, 0.0f);
+  r.link = uvec4(n.child0.w, n.child1.w, (n.origin.w >> 8) & 0x3fu, (n.origin.w >> 14) & 0x3fu);
+  return r;
+}
+
 // Per-ray constants of the slab test.
 struct BvhRay {
   vec3 origin;
@@ -257,7 +279,7 @@ SHARED_FN bool traceClosest(vec3 origin, vec3 dir, float tmin, float tmax, OUT(f
   uint node = 0u;
   bool found = false;
   for (;;) {
-    BvhNode n = BVH_NODE(node);
+    BvhNodeBoxes n = bvhDecodeNode(BVH_NODE(node));
     float enter0;
     float enter1;
     bool hit0 = bvhHitBox(ray, n.min0, n.max0, tmin, t, enter0);
@@ -301,7 +323,7 @@ SHARED_FN bool traceAny(vec3 origin, vec3 dir, float tmin, float tmax) {
   uint sp = 0u;
   uint node = 0u;
   for (;;) {
-    BvhNode n = BVH_NODE(node);
+    BvhNodeBoxes n = bvhDecodeNode(BVH_NODE(node));
     float enter0;
     float enter1;
     bool hit0 = bvhHitBox(ray, n.min0, n.max0, tmin, tmax, enter0);

@@ -126,17 +126,33 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 
 // ---- Structures ---------------------------------------------------------------------------------
 
-// A BVH node stores the boxes of both children (the fastest layout measured on lavapipe).
-// link = (child0, child1, count0, count1): count > 0 means the child is a leaf holding
-// triangles [child, child + count); count == 0 means child is an inner node index.
-struct BvhNode {
+// A BVH node as the traversal reads it: the boxes of both children (the fastest layout measured
+// on lavapipe) and link = (child0, child1, count0, count1): count > 0 means the child is a leaf
+// holding triangles [child, child + count); count == 0 means child is an inner node index.
+struct BvhNodeBoxes {
   vec4 min0;
   vec4 max0;
   vec4 min1;
   vec4 max1;
   uvec4 link;
 };
-STATIC_ASSERT_SIZE(BvhNode, 80);
+STATIC_ASSERT_SIZE(BvhNodeBoxes, 80);
+
+// A BVH node as stored (48 bytes instead of 80: six 64-bit loads per node instead of ten, layout.h
+// "64-bit loads"; docs/performance.md, "Compressed BVH nodes"). The child boxes are half floats
+// relative to the node: a bound is origin + h * 2^(E - 127) (bvhDecodeNode, shaders/shared/
+// bvh_traverse.h), h a half in [0, 1] or so, rounded outwards by the builder (a lower bound never
+// above the true one, an upper never below: src/scene/bvh.cpp, encodeBvhNode). An empty slot has
+// +inf lower and -inf upper halves (an inverted box).
+//   origin = (bits of the float origin x, y, z (the lowest corner of the two boxes),
+//             E | count0 << 8 | count1 << 14)
+//   child0 = (halves lo.x | lo.y << 16, lo.z | hi.x << 16, hi.y | hi.z << 16, child0 index); child1 alike.
+struct BvhNode {
+  uvec4 origin;
+  uvec4 child0;
+  uvec4 child1;
+};
+STATIC_ASSERT_SIZE(BvhNode, 48);
 
 // Intersection data of one triangle, in world space: v0 and two edges (Moller-Trumbore).
 struct GpuTriangle {
@@ -276,13 +292,7 @@ u64vec2 wideBits(vec4 v) { return wideBits(floatBitsToUint(v)); }
 #define loadQuadTable(b, i) wideQuadTable(Wide(b), i)
 #define loadQuadSet(b, i) wideQuadSet(Wide(b), i)
 BvhNode wideBvhNode(Wide w, uint i) {
-  BvhNode n;
-  n.min0 = wideVec4(w.v[5u * i]);
-  n.max0 = wideVec4(w.v[5u * i + 1u]);
-  n.min1 = wideVec4(w.v[5u * i + 2u]);
-  n.max1 = wideVec4(w.v[5u * i + 3u]);
-  n.link = wideUVec4(w.v[5u * i + 4u]);
-  return n;
+  return BvhNode(wideUVec4(w.v[3u * i]), wideUVec4(w.v[3u * i + 1u]), wideUVec4(w.v[3u * i + 2u]));
 }
 GpuTriangle wideTriangle(Wide w, uint i) {
   GpuTriangle t;

@@ -174,11 +174,11 @@ DeviceScene::DeviceScene(vk::Context& ctx, const Scene& scene, TraversalStructur
   // ---- Device buffers ----
   std::vector<BvhNode> nodes = bvh.nodes;
   if (nodes.empty()) {  // no triangles: a root whose two children are empty boxes
-    BvhNode n{};
+    shared::BvhNodeBoxes n{};
     n.min0 = n.min1 = glm::vec4(INFINITY);
     n.max0 = n.max1 = glm::vec4(-INFINITY);
     n.link = glm::uvec4(INVALID_INDEX, INVALID_INDEX, 0u, 0u);
-    nodes.push_back(n);
+    nodes.push_back(encodeBvhNode(n));
   }
   auto make = [&](vk::Buffer& b, VkDeviceSize bytes, const char* what, const void* data) {
     b = vk::createBuffer(m_ctx, bytes, 0, false, what);

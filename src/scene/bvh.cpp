@@ -9,7 +9,9 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <glm/gtc/packing.hpp>
 #include <limits>
+#include <stdexcept>
 #include <system_error>
 #include <thread>
 
@@ -17,13 +19,14 @@ namespace nusselt {
 namespace {
 
 using shared::BvhNode;
+using shared::BvhNodeBoxes;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 // SAH bins per axis: 32 is within a percent or two of a full sweep on typical meshes.
 constexpr int kBins = 32;
 // Cost of visiting one node relative to testing one triangle, as the GLSL traversal runs on a CPU
 // device (the BVH's users: --traversal auto takes ray queries on GPUs). By the arithmetic alone a
-// node visit (two boxes, 80 bytes) and a triangle test (48 bytes, a few cross products) are about
+// node visit (two boxes, 48 bytes compressed) and a triangle test (48 bytes, a few cross products) are about
 // even, but on lavapipe a visit is an iteration of a loop whose lanes diverge (stack, nearer
 // child, the leaf loops), where a leaf's triangles are tested by every lane in step. Measured
 // (bench render, 3 interleaved repeats; docs/performance.md): 4 with leaves of up to 32 triangles
@@ -123,7 +126,7 @@ class Builder {
   // above it). Inner nodes are appended to `out` with indices relative to `out`; leaf indices are
   // absolute positions in the prim array. Returns how the parent refers to it.
   ChildRef build(std::uint32_t begin, std::uint32_t end, std::uint32_t depth,
-                 std::vector<BvhNode>& out, LocalStats& stats) const {
+                 std::vector<BvhNodeBoxes>& out, LocalStats& stats) const {
     const std::uint32_t n = end - begin;
     ChildRef ref;
     Aabb centres;
@@ -179,7 +182,7 @@ class Builder {
     ref.count = 0;
 
     ChildRef left, right;
-    std::vector<BvhNode> rightNodes;
+    std::vector<BvhNodeBoxes> rightNodes;
     LocalStats rightStats;
     std::exception_ptr error;
     std::thread worker;
@@ -208,7 +211,7 @@ class Builder {
       worker.join();
       if (error) std::rethrow_exception(error);
       const std::uint32_t offset = static_cast<std::uint32_t>(out.size());
-      for (BvhNode& node : rightNodes) {
+      for (BvhNodeBoxes& node : rightNodes) {
         if (node.link.z == 0 && node.link.x != INVALID_INDEX) node.link.x += offset;
         if (node.link.w == 0 && node.link.y != INVALID_INDEX) node.link.y += offset;
       }
@@ -224,8 +227,8 @@ class Builder {
     return ref;
   }
 
-  static BvhNode makeNode(const ChildRef& a, const ChildRef& b) {
-    BvhNode node;
+  static BvhNodeBoxes makeNode(const ChildRef& a, const ChildRef& b) {
+    BvhNodeBoxes node;
     node.min0 = glm::vec4(a.box.lo, 0.0f);
     node.max0 = glm::vec4(a.box.hi, 0.0f);
     node.min1 = glm::vec4(b.box.lo, 0.0f);
@@ -306,14 +309,16 @@ class Builder {
   std::uint32_t parallelDepth_;
 };
 
-double computeSahCost(const std::vector<BvhNode>& nodes) {
+// The SAH cost of the tree (its exact boxes: the stored ones may round out to inf near the float
+// limit).
+double computeSahCost(const std::vector<BvhNodeBoxes>& nodes) {
   auto halfArea = [](glm::vec4 lo, glm::vec4 hi) {
     Aabb b;
     b.lo = glm::vec3(lo);
     b.hi = glm::vec3(hi);
     return b.halfArea();
   };
-  const BvhNode& root = nodes[0];
+  const BvhNodeBoxes& root = nodes[0];
   Aabb rootBox;
   rootBox.lo = glm::min(glm::vec3(root.min0), glm::vec3(root.min1));
   rootBox.hi = glm::max(glm::vec3(root.max0), glm::vec3(root.max1));
@@ -324,7 +329,7 @@ double computeSahCost(const std::vector<BvhNode>& nodes) {
     auto [index, area] = stack.back();
     stack.pop_back();
     cost += kTraversalCost * area / rootArea;
-    const BvhNode& node = nodes[index];
+    const BvhNodeBoxes& node = nodes[index];
     const std::uint32_t child[2] = {node.link.x, node.link.y};
     const std::uint32_t count[2] = {node.link.z, node.link.w};
     const double childArea[2] = {halfArea(node.min0, node.max0), halfArea(node.min1, node.max1)};
@@ -340,6 +345,67 @@ double computeSahCost(const std::vector<BvhNode>& nodes) {
 }
 
 }  // namespace
+
+namespace {
+
+// A bound as bvhDecodeNode computes it from half h (bits) at origin o and scale s.
+float decodeBound(float o, std::uint32_t h, float s) { return o + shared::halfBitsToFloat(h) * s; }
+
+// The half (bits, >= 0) whose decoded bound is the largest not above v (lower bounds) or the
+// smallest not below v (upper bounds). No subnormal halves: a device may flush them to 0 (which
+// would lower an upper bound), so a lower bound takes 0 and an upper one the smallest normal.
+std::uint32_t encodeBound(float v, float o, float s, bool upper) {
+  constexpr std::uint32_t kInfBits = 0x7c00u, kMinNormal = 0x0400u;
+  std::uint32_t h = glm::packHalf1x16(static_cast<float>((double(v) - double(o)) / double(s)));
+  if (h & 0x8000u) h = 0;  // a negative offset (rounding): start from 0
+  if (h > kInfBits) h = kInfBits;
+  if (upper) {
+    while (h < kInfBits && decodeBound(o, h, s) < v) ++h;
+    while (h > 0 && decodeBound(o, h - 1, s) >= v) --h;
+    if (h > 0 && h < kMinNormal) h = kMinNormal;
+  } else {
+    while (h > 0 && decodeBound(o, h, s) > v) --h;
+    while (h + 1 < kInfBits && decodeBound(o, h + 1, s) <= v) ++h;
+    if (h < kMinNormal) h = 0;
+  }
+  return h;
+}
+
+}  // namespace
+
+shared::BvhNode encodeBvhNode(const shared::BvhNodeBoxes& n) {
+  const glm::vec3 lo[2] = {glm::vec3(n.min0), glm::vec3(n.min1)};
+  const glm::vec3 hi[2] = {glm::vec3(n.max0), glm::vec3(n.max1)};
+  // An inverted box (an empty slot) stays inverted: +inf lower, -inf upper halves.
+  const bool empty[2] = {glm::any(glm::greaterThan(lo[0], hi[0])), glm::any(glm::greaterThan(lo[1], hi[1]))};
+  glm::vec3 origin(0.0f);
+  if (!empty[0] || !empty[1]) origin = empty[0] ? lo[1] : empty[1] ? lo[0] : glm::min(lo[0], lo[1]);
+  double extent = 0.0;
+  for (int c = 0; c < 2; ++c)
+    for (int k = 0; k < 3 && !empty[c]; ++k) extent = std::max(extent, double(hi[c][k]) - double(origin[k]));
+  // Scale 2^e >= the extent, so that the halves lie in [0, 1] (where they are finest); e >= -100
+  // keeps every product h * 2^e a normal float (the smallest normal half is 2^-14).
+  int e = -100;
+  while (e < 127 && std::ldexp(1.0, e) < extent) ++e;
+  const float scale = static_cast<float>(std::ldexp(1.0, e));
+  auto pack = [](std::uint32_t a, std::uint32_t b) { return a | (b << 16); };
+  glm::uvec4 child[2];
+  for (int c = 0; c < 2; ++c) {
+    std::uint32_t h[6];
+    for (int k = 0; k < 3; ++k) {
+      h[k] = empty[c] ? 0x7c00u : encodeBound(lo[c][k], origin[k], scale, false);
+      h[3 + k] = empty[c] ? 0xfc00u : encodeBound(hi[c][k], origin[k], scale, true);
+    }
+    child[c] = glm::uvec4(pack(h[0], h[1]), pack(h[2], h[3]), pack(h[4], h[5]), c == 0 ? n.link.x : n.link.y);
+  }
+  if (n.link.z > 0x3fu || n.link.w > 0x3fu) throw std::logic_error("BVH leaf of more than 63 triangles");
+  shared::BvhNode out;
+  out.origin = glm::uvec4(shared::floatBitsToUint(origin.x), shared::floatBitsToUint(origin.y),
+                          shared::floatBitsToUint(origin.z), std::uint32_t(e + 127) | (n.link.z << 8) | (n.link.w << 14));
+  out.child0 = child[0];
+  out.child1 = child[1];
+  return out;
+}
 
 Bvh buildBvh(const std::vector<glm::vec3>& positions) {
   const auto start = std::chrono::steady_clock::now();
@@ -365,14 +431,17 @@ Bvh buildBvh(const std::vector<glm::vec3>& positions) {
 
   Builder builder(prims.data(), parallelDepth);
   LocalStats stats;
-  bvh.nodes.reserve(count / 2 + 1);
-  ChildRef root = builder.build(0, count, 0, bvh.nodes, stats);
+  std::vector<BvhNodeBoxes> nodes;
+  nodes.reserve(count / 2 + 1);
+  ChildRef root = builder.build(0, count, 0, nodes, stats);
   if (root.count > 0) {
     // The whole scene fits in one leaf: the root (always an inner node) gets it as child0 and an
     // empty slot as child1 (inverted box, INVALID_INDEX, count 0; see bvh.h).
-    bvh.nodes.push_back(Builder::makeNode(root, ChildRef()));
+    nodes.push_back(Builder::makeNode(root, ChildRef()));
     stats.maxDepth = 1;
   }
+  bvh.nodes.resize(nodes.size());
+  for (std::size_t i = 0; i < nodes.size(); ++i) bvh.nodes[i] = encodeBvhNode(nodes[i]);
 
   bvh.triangleOrder.resize(count);
   for (std::uint32_t i = 0; i < count; ++i) bvh.triangleOrder[i] = prims[i].id;
@@ -381,7 +450,7 @@ Bvh buildBvh(const std::vector<glm::vec3>& positions) {
   bvh.stats.leaves = stats.leaves;
   bvh.stats.maxDepth = stats.maxDepth;
   bvh.stats.maxLeafSize = stats.maxLeafSize;
-  bvh.stats.sahCost = computeSahCost(bvh.nodes);
+  bvh.stats.sahCost = computeSahCost(nodes);
   bvh.stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return bvh;

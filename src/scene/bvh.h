@@ -1,8 +1,10 @@
 // bvh.h: the CPU builder of the bounding volume hierarchy the GPU traverses, and the C++ entry
 // points of that traversal (shaders/shared/bvh_traverse.h, one source for both builds).
 //
-// Node encoding (shared::BvhNode, shaders/shared/layout.h): a node stores the boxes of both of
-// its children; link = (child0, child1, count0, count1).
+// Node encoding (shared::BvhNodeBoxes, shaders/shared/layout.h): a node stores the boxes of both of
+// its children; link = (child0, child1, count0, count1). Stored as shared::BvhNode (48 bytes: the
+// boxes as half floats relative to the node, rounded outwards; encodeBvhNode below), which the
+// traversal decodes (bvhDecodeNode) into this form.
 //   - count > 0: the child is a leaf holding triangles [child, child + count) of the reordered
 //     triangle array (position i holds original triangle triangleOrder[i]); count <= kBvhMaxLeafSize.
 //   - count == 0 and child != INVALID_INDEX: the child is the inner node nodes[child].
@@ -48,6 +50,11 @@ struct Bvh {
   std::vector<std::uint32_t> triangleOrder;  // new position i holds original triangle triangleOrder[i]
   BvhBuildStats stats;
 };
+
+// The stored form of a node (shared::BvhNode, layout.h: 48 bytes, child boxes as half floats
+// relative to the node, rounded outwards: every decoded box (bvhDecodeNode) contains the exact one,
+// an inverted box stays inverted). Leaf counts above 63 throw std::logic_error.
+shared::BvhNode encodeBvhNode(const shared::BvhNodeBoxes& node);
 
 // positions: 3 per triangle (world space), all finite. Binned SAH (32 bins on each axis) with
 // SAH leaf termination, falling back to a median split where SAH would exceed the depth cap and

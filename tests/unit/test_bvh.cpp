@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "../../shaders/shared/alpha.h"
+#include "../../shaders/shared/bvh_traverse.h"
 #include "render/texture_table.h"
 #include "scene/bvh.h"
 #include "scene/scene.h"
@@ -17,7 +18,7 @@
 namespace nusselt {
 namespace {
 
-using shared::BvhNode;
+using shared::BvhNodeBoxes;
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
@@ -111,15 +112,19 @@ void checkStructure(const Bvh& bvh, const std::vector<glm::vec3>& p) {
   std::vector<int> nodeVisits(bvh.nodes.size(), 0);
   std::vector<int> triangleCovered(count, 0);
   std::uint32_t leaves = 0, maxDepth = 0, maxLeaf = 0, emptySlots = 0;
+  // A node with the boxes (as the traversal decodes them) of its ancestors' slots that lead to it:
+  // every one must contain every vertex below (the decoded boxes need not nest: each is rounded
+  // outwards on its own).
   struct Item {
     std::uint32_t node, depth;
+    std::vector<std::pair<glm::vec4, glm::vec4>> boxes;
   };
-  std::vector<Item> stack{{0, 0}};
+  std::vector<Item> stack{{0, 0, {}}};
   nodeVisits[0] = 1;
   while (!stack.empty()) {
     Item it = stack.back();
     stack.pop_back();
-    const BvhNode& n = bvh.nodes[it.node];
+    const BvhNodeBoxes n = shared::bvhDecodeNode(bvh.nodes[it.node]);
     const std::uint32_t child[2] = {n.link.x, n.link.y};
     const std::uint32_t cnt[2] = {n.link.z, n.link.w};
     const glm::vec4 lo[2] = {n.min0, n.min1}, hi[2] = {n.max0, n.max1};
@@ -134,7 +139,10 @@ void checkStructure(const Bvh& bvh, const std::vector<glm::vec3>& p) {
         for (std::uint32_t i = child[c]; i < child[c] + cnt[c]; ++i) {
           triangleCovered[i]++;
           const std::uint32_t o = bvh.triangleOrder[i];
-          for (int v = 0; v < 3; ++v) ASSERT_TRUE(contains(lo[c], hi[c], p[3 * o + v])) << "node " << it.node;
+          for (int v = 0; v < 3; ++v) {
+            ASSERT_TRUE(contains(lo[c], hi[c], p[3 * o + v])) << "node " << it.node;
+            for (const auto& [alo, ahi] : it.boxes) ASSERT_TRUE(contains(alo, ahi, p[3 * o + v])) << "node " << it.node;
+          }
         }
       } else if (child[c] == INVALID_INDEX) {
         // Empty slot: only the root of a one-leaf tree, with an inverted box.
@@ -146,13 +154,9 @@ void checkStructure(const Bvh& bvh, const std::vector<glm::vec3>& p) {
         ASSERT_LT(child[c], bvh.nodes.size());
         ASSERT_EQ(nodeVisits[child[c]], 0) << "node reached twice";
         nodeVisits[child[c]] = 1;
-        // Box nesting: the child's two boxes lie inside the box its parent stores for it.
-        const BvhNode& k = bvh.nodes[child[c]];
-        for (const auto& [clo, chi] : {std::pair{k.min0, k.max0}, std::pair{k.min1, k.max1}}) {
-          if (clo.x > chi.x) continue;  // inner nodes never have empty slots, but be exact
-          EXPECT_TRUE(contains(lo[c], hi[c], glm::vec3(clo)) && contains(lo[c], hi[c], glm::vec3(chi)));
-        }
-        stack.push_back({child[c], depth});
+        Item next{child[c], depth, it.boxes};
+        next.boxes.push_back({lo[c], hi[c]});
+        stack.push_back(std::move(next));
       }
     }
   }
@@ -218,6 +222,64 @@ std::vector<std::pair<glm::vec3, glm::vec3>> randomRays(int n, float extent, std
   return rays;
 }
 
+// The stored node (48 bytes, half-float child boxes relative to the node): every decoded box
+// contains the exact one, lies within the rounding the encoding allows of it (one half step of the
+// node's scale 2^e <= 2 x extent, plus float rounding of the sum), an empty slot stays inverted, and
+// the links survive. Boxes over many magnitudes: far from the origin, tiny, flat, near the float limit.
+TEST(Bvh, EncodedNodesContainTheirBoxesTightly) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const float offsets[] = {0.0f, 1.0f, -3.5f, 1e4f, -2e7f, 1e30f};
+  const float sizes[] = {0.0f, 1e-20f, 1e-6f, 1e-3f, 1.0f, 1e5f, 1e36f};
+  int checked = 0;
+  for (float off : offsets)
+    for (float size : sizes)
+      for (int trial = 0; trial < 40; ++trial) {
+        BvhNodeBoxes n{};
+        glm::vec3 lo[2], hi[2];
+        for (int c = 0; c < 2; ++c)
+          for (int k = 0; k < 3; ++k) {
+            float a = off + size * u(rng), b = off + size * u(rng);
+            lo[c][k] = std::min(a, b);
+            hi[c][k] = std::max(a, b);
+          }
+        const bool emptySlot = trial % 10 == 9;
+        n.min0 = glm::vec4(lo[0], 0.0f);
+        n.max0 = glm::vec4(hi[0], 0.0f);
+        n.min1 = emptySlot ? glm::vec4(kInf) : glm::vec4(lo[1], 0.0f);
+        n.max1 = emptySlot ? glm::vec4(-kInf) : glm::vec4(hi[1], 0.0f);
+        n.link = glm::uvec4(12345u + trial, emptySlot ? INVALID_INDEX : 7u, trial % 33, emptySlot ? 0u : 32u);
+        const BvhNodeBoxes d = shared::bvhDecodeNode(encodeBvhNode(n));
+        ASSERT_EQ(d.link, n.link);
+        double extent = 0.0;
+        glm::vec3 origin = emptySlot ? lo[0] : glm::min(lo[0], lo[1]);
+        for (int c = 0; c < (emptySlot ? 1 : 2); ++c)
+          for (int k = 0; k < 3; ++k) extent = std::max(extent, double(hi[c][k]) - double(origin[k]));
+        const glm::vec4 dlo[2] = {d.min0, d.min1}, dhi[2] = {d.max0, d.max1};
+        for (int c = 0; c < 2; ++c) {
+          if (c == 1 && emptySlot) {
+            EXPECT_EQ(dlo[1], glm::vec4(kInf, kInf, kInf, 0.0f));
+            EXPECT_EQ(dhi[1], glm::vec4(-kInf, -kInf, -kInf, 0.0f));
+            continue;
+          }
+          for (int k = 0; k < 3; ++k) {
+            const double ulps = 2.0 * std::max(double(std::nextafter(std::fabs(hi[c][k]), kInf) - std::fabs(hi[c][k])),
+                                               double(std::nextafter(std::fabs(lo[c][k]), kInf) - std::fabs(lo[c][k])));
+            const double tol = std::ldexp(extent, -9) + ulps + std::ldexp(1.0, -110);
+            ASSERT_LE(dlo[c][k], lo[c][k]) << "off " << off << " size " << size << " trial " << trial;
+            ASSERT_GE(dhi[c][k], hi[c][k]) << "off " << off << " size " << size << " trial " << trial;
+            ASSERT_LE(double(lo[c][k]) - double(dlo[c][k]), tol) << "off " << off << " size " << size;
+            ASSERT_LE(double(dhi[c][k]) - double(hi[c][k]), tol) << "off " << off << " size " << size;
+            ++checked;
+          }
+        }
+      }
+  EXPECT_EQ(checked, 6 * 7 * 40 * 6 - 6 * 7 * 4 * 3);
+  BvhNodeBoxes big{};
+  big.link = glm::uvec4(0u, 1u, 64u, 0u);
+  EXPECT_THROW(encodeBvhNode(big), std::logic_error);
+}
+
 TEST(Bvh, EmptyInput) {
   Bvh bvh = buildBvh({});
   EXPECT_TRUE(bvh.nodes.empty());
@@ -232,7 +294,7 @@ TEST(Bvh, OneTriangleHasRootWithEmptySlot) {
   Bvh bvh = buildBvh(p);
   checkStructure(bvh, p);
   ASSERT_EQ(bvh.nodes.size(), 1u);
-  const BvhNode& root = bvh.nodes[0];
+  const BvhNodeBoxes root = shared::bvhDecodeNode(bvh.nodes[0]);
   EXPECT_EQ(root.link.x, 0u);
   EXPECT_EQ(root.link.z, 1u);
   EXPECT_EQ(root.link.y, INVALID_INDEX);
