@@ -59,8 +59,8 @@ for s in "${scenes[@]}"; do
     read -r v tris < <(run "$bin_b" "$s" "$@")
     vb+=("$v")
   done
-  ma=$(printf '%s\n' "${va[@]}" | median)
-  mb=$(printf '%s\n' "${vb[@]}" | median)
+  ma=$(printf '%.0f' "$(printf '%s\n' "${va[@]}" | median)")
+  mb=$(printf '%.0f' "$(printf '%s\n' "${vb[@]}" | median)")
   printf '| %s (%s) | %s **%s** | %s **%s** | %.2fx |\n' "$(scene_name "$s")" "$tris" "${va[*]}" "$ma" "${vb[*]}" "$mb" \
     "$(calc "$mb / $ma")"
 done

@@ -291,49 +291,50 @@ u64vec2 wideBits(vec4 v) { return wideBits(floatBitsToUint(v)); }
 #define loadQuadLeaf(b, i) wideQuadLeaf(Wide(b), i)
 #define loadQuadTable(b, i) wideQuadTable(Wide(b), i)
 #define loadQuadSet(b, i) wideQuadSet(Wide(b), i)
+// Struct i of an array of structs of k 16-byte members: members at w.v[k i + m].
+#define WIDE_V4(m) wideVec4(w.v[o + uint(m)])
+#define WIDE_U4(m) wideUVec4(w.v[o + uint(m)])
 BvhNode wideBvhNode(Wide w, uint i) {
-  return BvhNode(wideUVec4(w.v[3u * i]), wideUVec4(w.v[3u * i + 1u]), wideUVec4(w.v[3u * i + 2u]));
+  uint o = 3u * i;
+  return BvhNode(WIDE_U4(0), WIDE_U4(1), WIDE_U4(2));
 }
 GpuTriangle wideTriangle(Wide w, uint i) {
-  GpuTriangle t;
-  t.v0 = wideVec4(w.v[3u * i]);
-  t.e1 = wideVec4(w.v[3u * i + 1u]);
-  t.e2 = wideVec4(w.v[3u * i + 2u]);
-  return t;
+  uint o = 3u * i;
+  return GpuTriangle(WIDE_V4(0), WIDE_V4(1), WIDE_V4(2));
 }
 GpuTriShading wideTriShading(Wide w, uint i) {
-  GpuTriShading s;
-  s.n0 = wideVec4(w.v[4u * i]);
-  s.n1 = wideVec4(w.v[4u * i + 1u]);
-  s.n2 = wideVec4(w.v[4u * i + 2u]);
-  s.info = wideUVec4(w.v[4u * i + 3u]);
-  return s;
+  uint o = 4u * i;
+  return GpuTriShading(WIDE_V4(0), WIDE_V4(1), WIDE_V4(2), WIDE_U4(3));
 }
 GpuLight wideLight(Wide w, uint i) {
-  GpuLight l;
-  l.info = wideUVec4(w.v[5u * i]);
-  l.position = wideVec4(w.v[5u * i + 1u]);
-  l.direction = wideVec4(w.v[5u * i + 2u]);
-  l.intensity = wideVec4(w.v[5u * i + 3u]);
-  l.cone = wideVec4(w.v[5u * i + 4u]);
-  return l;
+  uint o = 5u * i;
+  return GpuLight(WIDE_U4(0), WIDE_V4(1), WIDE_V4(2), WIDE_V4(3), WIDE_V4(4));
 }
-QuadNode wideQuadNode(Wide w, uint i) { return QuadNode(wideVec4(w.v[2u * i]), wideUVec4(w.v[2u * i + 1u])); }
+QuadNode wideQuadNode(Wide w, uint i) {
+  uint o = 2u * i;
+  return QuadNode(WIDE_V4(0), WIDE_U4(1));
+}
 QuadLeaf wideQuadLeaf(Wide w, uint i) {
-  return QuadLeaf(wideVec4(w.v[3u * i]), wideVec4(w.v[3u * i + 1u]), wideVec4(w.v[3u * i + 2u]));
+  uint o = 3u * i;
+  return QuadLeaf(WIDE_V4(0), WIDE_V4(1), WIDE_V4(2));
 }
-QuadTable wideQuadTable(Wide w, uint i) { return QuadTable(wideUVec4(w.v[2u * i]), wideVec4(w.v[2u * i + 1u])); }
-QuadSet wideQuadSet(Wide w, uint i) { return QuadSet(wideUVec4(w.v[2u * i]), wideVec4(w.v[2u * i + 1u])); }
+QuadTable wideQuadTable(Wide w, uint i) {
+  uint o = 2u * i;
+  return QuadTable(WIDE_U4(0), WIDE_V4(1));
+}
+QuadSet wideQuadSet(Wide w, uint i) {
+  uint o = 2u * i;
+  return QuadSet(WIDE_U4(0), WIDE_V4(1));
+}
 GpuMaterial wideMaterial(Wide w, uint i) {
   uint o = 12u * i;
-  GpuMaterial m;
-  m.info = wideUVec4(w.v[o]);
-  m.emission = wideVec4(w.v[o + 1u]);
-  for (uint k = 0u; k < BRDF_PARAM_VEC4S; ++k) m.params.v[k] = wideVec4(w.v[o + 2u + k]);
-  m.components = wideUVec4(w.v[o + 2u + BRDF_PARAM_VEC4S]);
-  m.absorption = wideVec4(w.v[o + 3u + BRDF_PARAM_VEC4S]);
-  return m;
+  BrdfParams p;
+  for (uint k = 0u; k < BRDF_PARAM_VEC4S; ++k) p.v[k] = wideVec4(w.v[o + 2u + k]);
+  uint after = o + 2u + BRDF_PARAM_VEC4S;  // components, absorption
+  return GpuMaterial(WIDE_U4(0), WIDE_V4(1), p, wideUVec4(w.v[after]), wideVec4(w.v[after + 1u]));
 }
+#undef WIDE_V4
+#undef WIDE_U4
 #endif
 
 // The environment: an equirectangular (lat-long) radiance map and its sampling distribution
