@@ -17,6 +17,7 @@
 #include <cstring>
 #include <glm/glm.hpp>
 #include <glm/gtc/constants.hpp>
+#include <glm/gtc/packing.hpp>  // unpackHalf2x16 (exact, as GLSL's)
 namespace nusselt {
 namespace shared {
 using namespace glm;
@@ -37,13 +38,6 @@ SHARED_FN float uintBitsToFloat(uint u) { float f; std::memcpy(&f, &u, 4); retur
 SHARED_FN uint floatBitsToUint(float f) { uint u; std::memcpy(&u, &f, 4); return u; }
 SHARED_FN float inversesqrt(float x) { return 1.0f / std::sqrt(x); }
 SHARED_FN bool isFinite(float x) { return std::isfinite(x); }
-// GLSL's unpackHalf2x16: the half floats in the low and high 16 bits, exactly (every half is a float).
-SHARED_FN float halfBitsToFloat(uint h) {
-  const uint sign = (h & 0x8000u) << 16, e = (h >> 10) & 0x1fu, m = h & 0x3ffu;
-  if (e == 0u) return (sign ? -1.0f : 1.0f) * std::ldexp(float(m), -24);  // zero, subnormal
-  return uintBitsToFloat(sign | (e == 31u ? 0x7f800000u : (e + 112u) << 23) | (m << 13));
-}
-SHARED_FN vec2 unpackHalf2x16(uint v) { return vec2(halfBitsToFloat(v & 0xffffu), halfBitsToFloat(v >> 16)); }
 SHARED_END
 #else
 #define SHARED_BEGIN

@@ -349,7 +349,7 @@ double computeSahCost(const std::vector<BvhNodeBoxes>& nodes) {
 namespace {
 
 // A bound as bvhDecodeNode computes it from half h (bits) at origin o and scale s.
-float decodeBound(float o, std::uint32_t h, float s) { return o + shared::halfBitsToFloat(h) * s; }
+float decodeBound(float o, std::uint32_t h, float s) { return o + glm::unpackHalf1x16(static_cast<glm::uint16>(h)) * s; }
 
 // The half (bits, >= 0) whose decoded bound is the largest not above v (lower bounds) or the
 // smallest not below v (upper bounds). No subnormal halves: a device may flush them to 0 (which
