@@ -97,24 +97,31 @@ SHARED_FN uint rngOwenScramble(uint x, uint seed) {
   return rngReverseBits(rngLaineKarras(rngReverseBits(x), seed));
 }
 
-// Second Sobol dimension: generator rows v0 = 2^31, v(i+1) = v(i) ^ (v(i) >> 1).
-// At most 32 iterations (one per set bit of the index).
-SHARED_FN uint rngSobol1(uint index) {
-  uint r = 0u;
-  uint v = 0x80000000u;
-  for (int i = 0; i < 32 && index != 0u; ++i) {
-    if ((index & 1u) != 0u) r ^= v;
-    index >>= 1u;
-    v ^= v >> 1u;
-  }
-  return r;
+// Second Sobol dimension, bit-reversed: generator rows v0 = 2^31, v(k+1) = v(k) ^ (v(k) >> 1), so
+// bit 31 - i of v(k) is C(k, i) mod 2, which is 1 iff the bits of i are a subset of those of k
+// (Lucas); the point is the xor of v(k) over the set bits k of the index. Bit i of the reversed
+// point is thus the parity of the index bits k whose positions contain i: a superset-parity
+// transform over the five bits of a position, one shift, mask and xor per position bit (the same
+// numbers as a loop over the generator rows, one per set bit: Rng.Sobol1MatchesItsRows).
+SHARED_FN uint rngSobol1Reversed(uint index) {
+  uint a = index;
+  a ^= (a >> 1u) & 0x55555555u;
+  a ^= (a >> 2u) & 0x33333333u;
+  a ^= (a >> 4u) & 0x0f0f0f0fu;
+  a ^= (a >> 8u) & 0x00ff00ffu;
+  a ^= (a >> 16u) & 0x0000ffffu;
+  return a;
 }
 
+// Each 2D draw: the index shuffled by a nested uniform scramble (Owen scrambling in the bit order
+// of the index: the first 2^m indices stay one aligned block of 2^m, a (0, m, 2)-net), then the
+// first two Sobol dimensions, radical inverse and rngSobol1Reversed, each Owen scrambled. An Owen
+// scramble is reverse(LK(reverse(x))), and both dimensions come bit-reversed, so one reversal each.
 SHARED_FN vec2 qmc2(uint pixel, uint sampleIndex, uint dimension, uint seed) {
   uvec4 h = pcg4d(uvec4(pixel, dimension, seed, 0x9e3779b9u));
   uint index = rngOwenScramble(sampleIndex, h.x);  // shuffles the order of the points
-  uint x = rngOwenScramble(rngReverseBits(index), h.y);
-  uint y = rngOwenScramble(rngSobol1(index), h.z);
+  uint x = rngReverseBits(rngLaineKarras(index, h.y));
+  uint y = rngReverseBits(rngLaineKarras(rngSobol1Reversed(index), h.z));
   return vec2(float(x >> 8u), float(y >> 8u)) * (1.0f / 16777216.0f);
 }
 

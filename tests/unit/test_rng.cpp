@@ -19,6 +19,24 @@ TEST(Rng, PcgInUnitInterval) {
   }
 }
 
+// The second Sobol dimension by its generator rows (v0 = 2^31, v(k+1) = v(k) ^ (v(k) >> 1)), one
+// row per set bit of the index: what rngSobol1Reversed computes in five steps, bit-reversed.
+static uint sobol1Rows(uint index) {
+  uint r = 0u, v = 0x80000000u;
+  for (int k = 0; k < 32; ++k, v ^= v >> 1u)
+    if ((index >> k) & 1u) r ^= v;
+  return r;
+}
+
+TEST(Rng, Sobol1MatchesItsRows) {
+  std::vector<uint> indices;
+  for (uint i = 0; i < 70000; ++i) indices.push_back(i);
+  for (uint i = 0; i < 200000; ++i) indices.push_back(pcg4d(uvec4(i, 1u, 2u, 3u)).x);
+  for (int k = 0; k < 32; ++k) indices.push_back(1u << k), indices.push_back(~(1u << k));
+  indices.push_back(0xffffffffu);
+  for (uint i : indices) ASSERT_EQ(rngReverseBits(rngSobol1Reversed(i)), sobol1Rows(i)) << "index " << i;
+}
+
 TEST(Rng, QmcIsA02NetForEveryPowerOfTwo) {
   for (uint dim : {0u, 1u, 5u, 123u})
     for (uint pixel : {0u, 77u, 4095u}) {
