@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Bit-identity check for refactors: renders a fixed set of small cases (every sampler, lighting
-# mode, random-number mode and roulette on the Cornell box; the materials scene; the test scenes;
-# combined materials; the dragon) and compares them with a recorded set. A refactor must leave
+# mode, random-number mode (the default qmc, and pcg) and roulette on the Cornell box; the
+# materials scene; the test scenes; combined materials; the dragon) and compares them with a
+# recorded set. A refactor must leave
 # every pixel and every counter of the header unchanged.
 #
 #   tools/identity.sh record DIR [NUSSELT]   render the cases into DIR (NUSSELT: default build/nusselt)
@@ -28,7 +29,7 @@ cases=(
   "cornell-uniform|$small --sampler uniform"
   "cornell-nee|$small --lighting nee"
   "cornell-bsdf|$small --lighting bsdf"
-  "cornell-qmc|$small --rng qmc"
+  "cornell-pcg|$small --rng pcg"
   "cornell-albedo-roulette|$small --roulette albedo"
   "cornell-offset|$small --spp-offset 5"
   "materials-quadtree|scenes/materials/materials.gltf $small"

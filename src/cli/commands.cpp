@@ -50,7 +50,7 @@ struct RenderArgs {
   std::uint32_t samplesPerPass = 0;
   int device = -1;
   std::string lighting = "mis";
-  std::string rng = "pcg";
+  std::string rng = rngModeName(RenderSettings{}.rng);
   std::string sampler = "quadtree";
   std::uint32_t roughnessBins = RenderSettings{}.roughnessBins;
   float roughnessBinSpacing = RenderSettings{}.roughnessBinSpacing;
@@ -467,6 +467,7 @@ struct BenchArgs {
   std::uint32_t maxDepth = 8;
   std::uint32_t samplesPerPass = 0;
   int device = -1;
+  std::string rng = rngModeName(RenderSettings{}.rng);
   std::vector<std::string> traversals{"auto"};
   std::uint32_t repeats = 1;
   std::string guiding = "off";
@@ -500,6 +501,7 @@ BenchRun benchRenderOnce(vk::Context& ctx, const Scene& scene, const std::string
   s.spp = a.spp;
   s.maxDepth = a.maxDepth;
   s.samplesPerPass = a.samplesPerPass;
+  parseRngMode(a.rng, s.rng);
   s.timeStages = true;
   s.traversal = traversal;
   s.guiding = a.guiding == "on";
@@ -840,7 +842,8 @@ int runCli(int argc, char** argv) {
                                                   "(rayquery on a GPU that offers it, else bvh: on CPU devices such as "
                                                   "lavapipe the BVH is faster, docs/performance.md)")
       ->capture_default_str()->check(CLI::IsMember(enumNames(kTraversalNames)));
-  render->add_option("--rng", ra.rng, "Random numbers: pcg (independent hashes) or qmc (padded Owen-scrambled Sobol)")
+  render->add_option("--rng", ra.rng, "Random numbers: qmc (padded Owen-scrambled Sobol points, one (0,2)-sequence per decision of the walk) or "
+                                          "pcg (independent hashes)")
       ->capture_default_str()->check(CLI::IsMember(enumNames(kRngNames)));
   render->add_option("--checkpoint", ra.checkpointSeconds, "Write the image so far to the output every this many seconds "
                                                           "(resumable with --resume; 0: never)")
@@ -934,6 +937,8 @@ int runCli(int argc, char** argv) {
                           "Samples per pixel per pass (0: chosen for the device, as render does)")
       ->capture_default_str()->check(CLI::Range(0u, 4096u));
   benchRender->add_option("--device", ba.device, "Vulkan device index");
+  benchRender->add_option("--rng", ba.rng, "Random numbers, as render --rng: qmc or pcg")
+      ->capture_default_str()->check(CLI::IsMember(enumNames(kRngNames)));
   benchRender->add_option("--traversal", ba.traversals, "Traversals to measure, interleaved within each repeat "
                                                          "(auto, rayquery, bvh; comma-separated or repeated)")
       ->capture_default_str()->delimiter(',')->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
