@@ -12,6 +12,10 @@ filter, at equal samples per pixel (or, with --time, for an equal time budget), 
     nusselt/renderSeconds);
   - Mitsuba 3 (`llvm_ad_rgb`, path tracer) in-process, after one untimed render that JIT-compiles
     its kernels; nusselt also gets one untimed run first (it fills the quadtree cache on disk).
+    With --mitsuba-sampler independent,ldsampler Mitsuba is timed with each of its samplers in
+    turn (after each nusselt run) and nusselt compared with each: nusselt's default random
+    numbers are scrambled Sobol points (--rng qmc), whose counterpart in Mitsuba is ldsampler,
+    while Mitsuba's default (and mitsuba.cornell_box()'s) is the independent sampler.
 
 Error: relMSE = mean over pixels and channels of (x - ref)^2 / (ref^2 + 0.01), against one
 converged reference per scene rendered by Mitsuba (--ref-spp, cached in --cache). Where the two
@@ -37,6 +41,7 @@ Examples:
   tools/bench_vs_mitsuba.py --scene all --markdown docs/performance.md
   tools/bench_vs_mitsuba.py --nusselt-args "--roulette albedo" --repeats 3
   tools/bench_vs_mitsuba.py --time 5                         # equal time (nusselt render --time)
+  tools/bench_vs_mitsuba.py --mitsuba-sampler independent,ldsampler
 """
 import argparse
 import datetime
@@ -98,6 +103,11 @@ def parse_args(argv):
     p.add_argument("--venv", default=os.path.expanduser("~/.cache/nusselt/mitsuba-venv"),
                    help="the venv holding Mitsuba (created when missing; default ~/.cache/nusselt/mitsuba-venv)")
     p.add_argument("--variant", default="llvm_ad_rgb", help="Mitsuba variant (default llvm_ad_rgb)")
+    p.add_argument("--mitsuba-sampler", default="independent", metavar="LIST",
+                   help="Mitsuba's samplers for the timed renders, comma-separated (default independent, its "
+                        "default and mitsuba.cornell_box()'s; ldsampler: its randomly scrambled (0,2)-sequences, "
+                        "the counterpart of nusselt's --rng qmc; also stratified, multijitter, orthogonal); each "
+                        "is timed and compared in turn. References are rendered with independent")
     p.add_argument("--markdown", metavar="FILE",
                    help="write the results as a markdown section into FILE (between the tool's markers; "
                         "the rest of the file is kept)")
@@ -379,7 +389,7 @@ def write_ply(path, positions, normals, indices):
         f.write(faces.tobytes())
 
 
-def mitsuba_scene_dict(scene, mesh_dir, width, height, spp, max_depth):
+def mitsuba_scene_dict(scene, mesh_dir, width, height, spp, max_depth, sampler="independent"):
     """The Mitsuba scene of a loaded glTF: every primitive as a PLY of the same float32 vertex
     arrays (flat-shaded unless the glTF has NORMAL), the same camera, a box filter. Returns
     (dict, whether every BSDF is identical to nusselt's)."""
@@ -413,7 +423,7 @@ def mitsuba_scene_dict(scene, mesh_dir, width, height, spp, max_depth):
         "type": "perspective", "fov_axis": "y", "fov": float(np.degrees(persp["yfov"])),
         "near_clip": float(persp.get("znear", 0.01)), "far_clip": float(persp.get("zfar", 1e7)),
         "to_world": mi.ScalarTransform4f(to_world),
-        "sampler": {"type": "independent", "sample_count": spp},
+        "sampler": {"type": sampler, "sample_count": spp},
         "film": {"type": "hdrfilm", "width": width, "height": height, "rfilter": {"type": "box"},
                  "pixel_format": "rgb", "component_format": "float32"},
     }
@@ -567,12 +577,14 @@ class Mitsuba:
 
     def load(self, scene_dict):
         self.scene = self.mi.load_dict(scene_dict)
+        return self.scene
 
-    def render(self, spp, seed):
-        """(rgb, seconds) of one render (the kernels' JIT time included if they are new)."""
+    def render(self, spp, seed, scene=None):
+        """(rgb, seconds) of one render of `scene` (default: the last loaded; the kernels' JIT time
+        included if they are new)."""
         import numpy as np
         t0 = time.perf_counter()
-        img = self.mi.render(self.scene, spp=spp, seed=seed)
+        img = self.mi.render(scene if scene is not None else self.scene, spp=spp, seed=seed)
         self.dr.eval(img)
         self.dr.sync_thread()
         secs = time.perf_counter() - t0
@@ -658,6 +670,10 @@ def bench_scene(name, path, args, nus, mts, workdir):
     gl = load_gltf(path)
     sdict, identical = mitsuba_scene_dict(gl, os.path.join(workdir, f"meshes-{name}"), args.width, args.height,
                                           args.spp, args.max_depth)
+    # One Mitsuba scene per timed sampler (the reference's, independent, is loaded last).
+    samplers = mitsuba_samplers(args)
+    scenes = {s: mts.load(mitsuba_scene_dict(gl, os.path.join(workdir, f"meshes-{name}"), args.width, args.height,
+                                             args.spp, args.max_depth, s)[0]) for s in samplers}
     mts.load(sdict)
     res = {"name": name, "path": os.path.relpath(path, ROOT), "identical": identical,
            "triangles": int(sum(len(p["indices"]) for p in gl["primitives"]))}
@@ -712,16 +728,20 @@ def bench_scene(name, path, args, nus, mts, workdir):
     # Warm-up: Mitsuba JIT-compiles its kernels; nusselt fills its quadtree cache.
     say("  warm-up (untimed)")
     nus.render(path, args.spp, 0, time_budget=None)
-    _, t_first = mts.render(args.spp, 0)
-    m_spp = args.spp
-    if time_budget is not None:
-        _, t_cal = mts.render(args.spp, 0)
-        m_spp = max(1, round(time_budget * args.spp / t_cal))
-        if m_spp != args.spp:
-            mts.render(m_spp, 0)  # compile for the new sample count, if it needs to
-    res["mitsuba_first_render"] = t_first
+    m_spp, first = {}, {}
+    for s in samplers:
+        _, first[s] = mts.render(args.spp, 0, scenes[s])
+        m_spp[s] = args.spp
+        if time_budget is not None:
+            _, t_cal = mts.render(args.spp, 0, scenes[s])
+            m_spp[s] = max(1, round(time_budget * args.spp / t_cal))
+            if m_spp[s] != args.spp:
+                mts.render(m_spp[s], 0, scenes[s])  # compile for the new sample count, if it needs to
+    res["mitsuba_first_render"] = first
 
-    rows = {"nusselt": [], "mitsuba": []}
+    # Interleaved: nusselt, then Mitsuba with each sampler, per repeat.
+    who = ["nusselt"] + [mitsuba_label(s) for s in samplers]
+    rows = {w: [] for w in who}
     last = {}
     for i in range(args.repeats):
         seed = i + 1
@@ -729,22 +749,29 @@ def bench_scene(name, path, args, nus, mts, workdir):
         rows["nusselt"].append({"spp": int(hdr.get("nusselt/spp", args.spp)), "wall": wall, "render": secs,
                                 "relmse": rel_mse(rgb, nref)})
         last["nusselt"] = rgb
-        img, t = mts.render(m_spp, seed)
-        rows["mitsuba"].append({"spp": m_spp, "wall": t, "render": t, "relmse": rel_mse(img, mref)})
-        last["mitsuba"] = img
-        n, m = rows["nusselt"][-1], rows["mitsuba"][-1]
-        say(f"  repeat {i + 1}/{args.repeats}: nusselt {n['spp']} spp {n['wall']:.2f} s (render {n['render']:.2f} s) "
-            f"relMSE {n['relmse']:.5f}; mitsuba {m['spp']} spp {m['wall']:.2f} s relMSE {m['relmse']:.5f}")
+        n = rows["nusselt"][-1]
+        line = f"  repeat {i + 1}/{args.repeats}: nusselt {n['spp']} spp {n['wall']:.2f} s (render {n['render']:.2f} s) relMSE {n['relmse']:.5f}"
+        for s in samplers:
+            img, t = mts.render(m_spp[s], seed, scenes[s])
+            rows[mitsuba_label(s)].append({"spp": m_spp[s], "wall": t, "render": t, "relmse": rel_mse(img, mref)})
+            last[mitsuba_label(s)] = img
+            m = rows[mitsuba_label(s)][-1]
+            line += f"; {mitsuba_label(s)} {m['spp']} spp {m['wall']:.2f} s relMSE {m['relmse']:.5f}"
+        say(line)
     res["rows"] = rows
-    res["ratio_process"] = [n["relmse"] * n["wall"] / (m["relmse"] * m["wall"]) for n, m in zip(rows["nusselt"], rows["mitsuba"])]
-    res["ratio_render"] = [n["relmse"] * n["render"] / (m["relmse"] * m["wall"]) for n, m in zip(rows["nusselt"], rows["mitsuba"])]
+    res["samplers"] = samplers
+    # Per Mitsuba sampler: (relMSE x time) of nusselt over Mitsuba's, per repeat.
+    res["ratio_process"] = {w: [n["relmse"] * n["wall"] / (m["relmse"] * m["wall"]) for n, m in zip(rows["nusselt"], rows[w])]
+                            for w in who[1:]}
+    res["ratio_render"] = {w: [n["relmse"] * n["render"] / (m["relmse"] * m["wall"]) for n, m in zip(rows["nusselt"], rows[w])]
+                           for w in who[1:]}
     if args.images:
         os.makedirs(args.images, exist_ok=True)
         write_images(os.path.join(args.images, f"{name}-ref-mitsuba"), mref)
         if not identical:
             write_images(os.path.join(args.images, f"{name}-ref-nusselt"), nref)
-        write_images(os.path.join(args.images, f"{name}-nusselt"), last["nusselt"])
-        write_images(os.path.join(args.images, f"{name}-mitsuba"), last["mitsuba"])
+        for w, img in last.items():
+            write_images(os.path.join(args.images, f"{name}-{w.replace(' ', '-')}"), img)
     return res
 
 
@@ -765,19 +792,33 @@ def fmt_stat(values, spec):
     return f"{num(med, spec)} [{num(lo, spec)}-{num(hi, spec)}]"
 
 
+def mitsuba_samplers(args):
+    s = [x.strip() for x in args.mitsuba_sampler.split(",") if x.strip()]
+    if not s:
+        raise SystemExit("--mitsuba-sampler: no sampler given")
+    return s
+
+
+def mitsuba_label(sampler):
+    return "mitsuba" if sampler == "independent" else f"mitsuba {sampler}"
+
+
 def table(results):
-    """Rows of the results table (header first)."""
-    rows = [["scene", "renderer", "spp", "time s", "render s", "relMSE", "relMSE x time", "ratio"]]
+    """Rows of the results table (header first): nusselt, then Mitsuba with each sampler, whose
+    row holds nusselt's ratio to it."""
+    rows = [["scene", "renderer", "spp", "time s", "render s", "relMSE", "relMSE x time", "ratio nusselt / this"]]
     for r in results:
-        for who in ("nusselt", "mitsuba"):
+        for who in r["rows"]:
             rr = r["rows"][who]
             spp = fmt_stat([x["spp"] for x in rr], ".0f")
             prod = [x["relmse"] * x["wall"] for x in rr]
             if who == "nusselt":
-                ratio = fmt_stat(r["ratio_process"], "#.3g") + " (render time: " + fmt_stat(r["ratio_render"], "#.3g") + ")"
+                ratio = "-"
                 render = fmt_stat([x["render"] for x in rr], "#.3g")
             else:
-                ratio, render = "1", "-"
+                ratio = (fmt_stat(r["ratio_process"][who], "#.3g") + " (render time: " +
+                         fmt_stat(r["ratio_render"][who], "#.3g") + ")")
+                render = "-"
             rows.append([r["name"], who, spp, fmt_stat([x["wall"] for x in rr], "#.3g"), render,
                          fmt_stat([x["relmse"] for x in rr], "#.3g"), fmt_stat(prod, "#.3g"), ratio])
     return rows
@@ -804,8 +845,12 @@ def markdown(results, args, info, started, finished, command):
     L.append(f"- nusselt devices: " + "; ".join(f"`{d}`" for d in info["devices"]) +
              f". Package mesa-vulkan-drivers {info['mesa_package']}" +
              (f", VK_ICD_FILENAMES={info['icd']}" if info["icd"] else "") + ".")
+    samplers = mitsuba_samplers(args)
     L.append(f"- Mitsuba {MITSUBA_VERSION} (Dr.Jit {DRJIT_VERSION}, variant `{args.variant}`, path tracer, "
-             f"independent sampler, Russian roulette from depth 5), LLVM `{os.environ.get('DRJIT_LIBLLVM_PATH', '')}`.")
+             f"Russian roulette from depth 5), LLVM `{os.environ.get('DRJIT_LIBLLVM_PATH', '')}`; samplers: " +
+             ", ".join(f"`{s}`" + (" (its default)" if s == "independent" else
+                                   " (randomly scrambled (0,2)-sequences per pair of dimensions: the counterpart of "
+                                   "nusselt's `--rng qmc`)" if s == "ldsampler" else "") for s in samplers) + ".")
     mode = results[0]["mode"] if results else "equal spp"
     settings = (f"{args.width} x {args.height} pixels, box filter, nusselt `--max-depth {args.max_depth}` = Mitsuba "
                 f"`max_depth` {args.max_depth + 1}")
@@ -817,14 +862,14 @@ def markdown(results, args, info, started, finished, command):
             settings += f" (--time {args.time:g} asked, but this nusselt has no `render --time`)"
     if args.nusselt_args:
         settings += f", nusselt arguments `{args.nusselt_args}`"
-    L.append(f"- Settings: {settings}; {args.repeats} repeats, interleaved (nusselt, Mitsuba, nusselt, ...); "
-             "medians with [min-max].")
+    L.append(f"- Settings: {settings}; {args.repeats} repeats, interleaved (nusselt, Mitsuba with each sampler, "
+             "nusselt, ...); medians with [min-max].")
     L.append("- Timing: nusselt as a whole process (`time s`: start-up, pipelines, scene, EXR write) and by its "
              "own render time (`render s`, EXR header `nusselt/renderSeconds`); Mitsuba in-process after one "
              "untimed render that JIT-compiles its kernels (nusselt also gets one untimed run first).")
-    L.append("- relMSE: mean over pixels and channels of (x - ref)^2 / (ref^2 + 0.01). Ratio = (relMSE x time) of "
-             "nusselt / (relMSE x time) of Mitsuba per repeat, nusselt timed as a process (in brackets: by its "
-             "render time); above 1, Mitsuba reaches the same error sooner.")
+    L.append("- relMSE: mean over pixels and channels of (x - ref)^2 / (ref^2 + 0.01). Ratio (in each Mitsuba row) = "
+             "(relMSE x time) of nusselt / (relMSE x time) of that Mitsuba run, per repeat, nusselt timed as a process "
+             "(in brackets: by its render time); above 1, Mitsuba reaches the same error sooner.")
     L.append("")
     rows = table(results)
     L.append("| " + " | ".join(rows[0]) + " |")
@@ -857,11 +902,16 @@ def markdown(results, args, info, started, finished, command):
                      f"; best alignment {c['best_alignment']} (mean z^2 {c['best_mean_z2']:.3f}): "
                      + ("**agree**." if c["agrees"] else "**disagree**" +
                         (" (expected: the BSDFs differ)." if not r["identical"] else ".")))
-        L.append(f"  Mitsuba's first render of the scene (JIT compilation included, not counted): "
-                 f"{r['mitsuba_first_render']:.2f} s.")
-        per = "; ".join(f"nusselt {n['spp']} spp {n['wall']:.2f} s (render {n['render']:.2f} s) relMSE {n['relmse']:.4g}, "
-                        f"Mitsuba {m['spp']} spp {m['wall']:.2f} s relMSE {m['relmse']:.4g}"
-                        for n, m in zip(r["rows"]["nusselt"], r["rows"]["mitsuba"]))
+        L.append(f"  Mitsuba's first render of the scene (JIT compilation included, not counted): " +
+                 ", ".join(f"{t:.2f} s ({s})" for s, t in r["mitsuba_first_render"].items()) + ".")
+        reps = []
+        for i, n in enumerate(r["rows"]["nusselt"]):
+            t = f"nusselt {n['spp']} spp {n['wall']:.2f} s (render {n['render']:.2f} s) relMSE {n['relmse']:.4g}"
+            for w in list(r["rows"])[1:]:
+                m = r["rows"][w][i]
+                t += f", {w.replace('mitsuba', 'Mitsuba')} {m['spp']} spp {m['wall']:.2f} s relMSE {m['relmse']:.4g}"
+            reps.append(t)
+        per = "; ".join(reps)
         L.append(f"  Repeats in order: {per}.")
     L.append(MARK_END)
     return "\n".join(L) + "\n"
