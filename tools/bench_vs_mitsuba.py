@@ -748,6 +748,7 @@ def bench_scene(name, path, args, nus, mts, workdir):
         rgb, _, hdr, wall, secs = nus.render(path, args.spp, seed, time_budget=time_budget)
         rows["nusselt"].append({"spp": int(hdr.get("nusselt/spp", args.spp)), "wall": wall, "render": secs,
                                 "relmse": rel_mse(rgb, nref)})
+        res["nusselt_rng"] = str(hdr.get("nusselt/rng", "pcg"))  # the header's; older binaries: pcg
         last["nusselt"] = rgb
         n = rows["nusselt"][-1]
         line = f"  repeat {i + 1}/{args.repeats}: nusselt {n['spp']} spp {n['wall']:.2f} s (render {n['render']:.2f} s) relMSE {n['relmse']:.5f}"
@@ -862,6 +863,8 @@ def markdown(results, args, info, started, finished, command):
             settings += f" (--time {args.time:g} asked, but this nusselt has no `render --time`)"
     if args.nusselt_args:
         settings += f", nusselt arguments `{args.nusselt_args}`"
+    rngs = sorted({r.get("nusselt_rng", "pcg") for r in results})
+    settings += ", nusselt's random numbers " + ", ".join(f"`{x}`" for x in rngs) + " (`--rng`)"
     L.append(f"- Settings: {settings}; {args.repeats} repeats, interleaved (nusselt, Mitsuba with each sampler, "
              "nusselt, ...); medians with [min-max].")
     L.append("- Timing: nusselt as a whole process (`time s`: start-up, pipelines, scene, EXR write) and by its "
