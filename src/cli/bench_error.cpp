@@ -618,7 +618,6 @@ int benchError(const ErrorArgs& a) {
       progress.update(++step);
     };
     std::uint32_t seed = 1;
-    RenderResult quadPcg;
     for (std::uint32_t st : kStrategies) {
       s.sampler = samplerKind(st);
       s.seed = seed++;
@@ -626,19 +625,21 @@ int benchError(const ErrorArgs& a) {
       add("strategies", strategyName(st), r);
       writeExr(a.out + "/scene-" + sc.name + "-" + strategyName(st) + ".exr", r.image);
       images.push_back(r.image);
-      if (st == SAMPLER_QUADTREE) quadPcg = r;
     }
     writeSideBySide(a.out + "/scene-" + sc.name + ".png", ref.image, images);
     if (sc.name == "cornell") {
-      rows.push_back(rows[rows.size() - kStrategies.size()]);  // the quadtree PCG row again
+      // The strategies rendered with the default random numbers (RenderSettings::rng, QMC): the
+      // quadtree's row again, and the other mode rendered here.
+      const RngMode byDefault = s.rng;
+      rows.push_back(rows[rows.size() - kStrategies.size()]);
       rows.back().experiment = "rng";
-      rows.back().variant = "pcg";
+      rows.back().variant = rngModeName(byDefault);
       s.sampler = SamplerKind::Quadtree;
-      s.rng = RngMode::Qmc;
+      s.rng = byDefault == RngMode::Qmc ? RngMode::Pcg : RngMode::Qmc;
       s.seed = seed++;
       RenderResult r = renderTimed(ctx, scene, s);
-      add("rng", "qmc", r);  // (reruns, if any, with these settings)
-      s.rng = RngMode::Pcg;
+      add("rng", rngModeName(s.rng), r);  // (reruns, if any, with these settings)
+      s.rng = byDefault;
     }
     if (sc.name == "cornell-combined") {
       rows.push_back(rows[rows.size() - kStrategies.size()]);

@@ -42,6 +42,7 @@ awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "agree") c = i; next }
   fail "renders disagree with their references"
 grep -qiwE "nan|inf" "$work/out/scenes.csv" && fail "non-finite value in scenes.csv"
 grep -q "^rng,cornell,qmc," "$work/out/scenes.csv" || fail "no QMC row"
+grep -q "^rng,cornell,pcg," "$work/out/scenes.csv" || fail "no PCG row"
 grep -q "^components,cornell-combined,uniform," "$work/out/scenes.csv" || fail "no uniform component-choice row"
 
 # The report: summary first, one table per family of the quick run's models.
