@@ -125,7 +125,7 @@ struct RenderSettings {
   std::uint32_t maxDepth = 8;       // pbrt's convention: 0 = emitted light only, 1 = direct light
   std::uint32_t seed = 0;
   LightingMode lighting = LightingMode::Mis;
-  // Scrambled Sobol points: on the Cornell boxes 0.6-0.8x the relMSE of independent numbers at equal
+  // Scrambled Sobol points: on the Cornell boxes 0.6-0.9x the relMSE of independent numbers at equal
   // spp, for a few % more time (docs/performance.md, "Random numbers").
   RngMode rng = RngMode::Qmc;
   SamplerKind sampler = SamplerKind::Quadtree;  // the generic sampler of Montes et al.
