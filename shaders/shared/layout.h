@@ -18,13 +18,21 @@ SHARED_BEGIN
 // Model slots: a render has one shade pipeline (and one shade queue) per reflectance model its
 // scene uses. 32 > the 20 models of the catalogue, room for measured BRDFs later.
 #define MAX_MODEL_SLOTS 32
-// Counters live at the head of the queue buffer; item arrays follow.
-#define QUEUE_HEADER_UINTS 64
+// Counters live at the head of the queue buffer; item arrays follow. Each queue has two counters,
+// one per shard (QUEUE_SHARD_STRIDE apart: separate cache lines), see "Queue ids".
+#define QUEUE_SHARD_STRIDE 64u
+#define QUEUE_HEADER_UINTS 128
 // Bounded BVH stack: depth of the tree is capped at build time to fit (src/scene/bvh.cpp).
 #define BVH_STACK_SIZE 64
 
 // ---- Queue ids --------------------------------------------------------------------------------
-// A queue is a count (queues[id]) plus path ids (queues[QUEUE_HEADER_UINTS + id * capacity + i]).
+// A queue is path ids (queues[QUEUE_HEADER_UINTS + id * capacity + slot]) filled by two shards:
+// shard 0 from the array's start (count queues[id]), shard 1 from its end backwards (count
+// queues[QUEUE_SHARD_STRIDE + id]); item i is shard 0's i-th, or shard 1's (i - count0)-th
+// (stage_common.glsl, queueItem). A pushing workgroup in the first half of its dispatch uses shard
+// 0, the second half shard 1: lavapipe gives each of its threads a contiguous block of a
+// dispatch's workgroups, so with two threads each pushes to a counter and a part of the array of
+// its own instead of both contending for one cache line (docs/performance.md, "Queue shards").
 // Ray queues ping-pong by bounce parity (ray queue b & 1 holds bounce b's rays), and so do the
 // shadow queues: shade(b) fills shadow queue b & 1, which the trace stage of bounce b + 1 consumes
 // together with that bounce's rays (PathIntegrator::recordPass).

@@ -144,9 +144,14 @@ const bool GUIDING = false;
 
 // ---- Queues ---------------------------------------------------------------------------------
 
-uint queueCount(uint queue) { return g.queues.v[queue]; }
+uint queueCount(uint queue) { return g.queues.v[queue] + g.queues.v[QUEUE_SHARD_STRIDE + queue]; }
 
-uint queueItem(uint queue, uint i) { return g.queues.v[QUEUE_HEADER_UINTS + queue * g.pathCapacity + i]; }
+// Item i < queueCount(queue): shard 0's items first, then shard 1's (layout.h, "Queue ids").
+uint queueItem(uint queue, uint i) {
+  uint first = g.queues.v[queue];
+  uint slot = i < first ? i : g.pathCapacity - 1u - (i - first);
+  return g.queues.v[QUEUE_HEADER_UINTS + queue * g.pathCapacity + slot];
+}
 
 // Push a path id. Lanes of a subgroup may push to different queues (intersect sends each hit
 // to its model's shade queue): the lanes pushing to the same queue as the first remaining lane
@@ -162,22 +167,27 @@ void queuePush(uint queue, uint path) {
       uvec4 ballot = subgroupBallot(true);
       uint n = subgroupBallotBitCount(ballot);
       uint rank = subgroupBallotExclusiveBitCount(ballot);
+      // The shard of this workgroup's half of the dispatch (layout.h, "Queue ids").
+      uint shard = gl_WorkGroupID.x >= gl_NumWorkGroups.x / 2u ? 1u : 0u;
       uint base = 0u;
       if (subgroupElect()) {
-        base = atomicAdd(g.queues.v[queue], n);
+        base = atomicAdd(g.queues.v[shard * QUEUE_SHARD_STRIDE + queue], n);
         // Only a push that opens a workgroup (crosses a multiple of WORKGROUP_SIZE) touches the
         // dispatch sizes: one in WORKGROUP_SIZE / subgroup size pushes, so the two cores rarely
         // contend for their cache line (the count's atomic is the only one of the others).
+        // Each shard opens its own workgroups: the dispatch has ceil(count0 / WORKGROUP_SIZE) +
+        // ceil(count1 / WORKGROUP_SIZE) of them, at most one more than the items need (its
+        // consumer's lanes past queueCount return).
         uint groups = (base + n + WORKGROUP_SIZE - 1u) / WORKGROUP_SIZE;
         uint opened = groups - (base + WORKGROUP_SIZE - 1u) / WORKGROUP_SIZE;
         if (opened > 0u) {
           Uints args = Uints(g.dispatchArgs);
-          atomicMax(args.v[4u * queue], groups);
+          atomicAdd(args.v[4u * queue], opened);
           args.v[4u * queue + 1u] = 1u;
           args.v[4u * queue + 2u] = 1u;
           // The trace stage that consumes this queue runs the workgroups of its ray queue and of
-          // its shadow queue in one dispatch: each push adds the workgroups it opened (the pushes'
-          // ranges are disjoint, so the additions sum to ceil(count / WORKGROUP_SIZE)). Ray queue q
+          // its shadow queue in one dispatch: each push adds the workgroups it opened (a shard's
+          // pushes' ranges are disjoint, so the additions sum to its ceil(count / WORKGROUP_SIZE)). Ray queue q
           // feeds trace(b) with b & 1 = q; shadow queue s (filled at bounce b, s = b & 1) feeds
           // trace(b + 1).
           if (queue <= QUEUE_SHADOW1) {
@@ -188,8 +198,9 @@ void queuePush(uint queue, uint path) {
           }
         }
       }
-      base = subgroupBroadcastFirst(base);
-      g.queues.v[QUEUE_HEADER_UINTS + queue * g.pathCapacity + base + rank] = path;
+      base = subgroupBroadcastFirst(base) + rank;
+      uint slot = shard == 0u ? base : g.pathCapacity - 1u - base;
+      g.queues.v[QUEUE_HEADER_UINTS + queue * g.pathCapacity + slot] = path;
       return;
     }
   }

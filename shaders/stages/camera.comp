@@ -9,6 +9,24 @@
 // anywhere on the image and the path's pixel follows from it, so a chain moves across pixels.
 layout(constant_id = 12) const bool IMAGE_SAMPLES = false;
 
+// The slot of path i in ray queue 0: blocks of CAMERA_BLOCK paths (contiguous in memory and in
+// the image) dealt out with stride CAMERA_BLOCK_STRIDE, so that each half of the first trace
+// dispatch, and each thread's share of it on lavapipe (which gives its threads contiguous blocks
+// of a dispatch's workgroups), holds paths from every part of the image: otherwise the thread that
+// gets the image's costlier half (the dragon, the glass sphere) leaves the other idle, at this
+// bounce and, through the queue shards (layout.h), at the next. The blocks of a whole number of
+// strides are dealt; the rest keep their places. A permutation of the queue only: every path keeps
+// its index, pixel and numbers, so images are unchanged.
+const uint CAMERA_BLOCK = 16u * WORKGROUP_SIZE;
+const uint CAMERA_BLOCK_STRIDE = 8u;
+uint cameraQueueSlot(uint i) {
+  uint blocks = (g.chunkPaths / (CAMERA_BLOCK * CAMERA_BLOCK_STRIDE)) * CAMERA_BLOCK_STRIDE;
+  uint b = i / CAMERA_BLOCK;
+  if (b >= blocks) return i;
+  uint dealt = (b % CAMERA_BLOCK_STRIDE) * (blocks / CAMERA_BLOCK_STRIDE) + b / CAMERA_BLOCK_STRIDE;
+  return dealt * CAMERA_BLOCK + i % CAMERA_BLOCK;
+}
+
 void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= g.chunkPaths) return;
@@ -47,7 +65,7 @@ void main() {
   storeVec4(g.pathRadiance, i, vec4(0.0f));
   storeUVec4(g.pathInfo, i, uvec4(pixel, sampleIndex, 0u, 0u));
   if (GUIDING) guideRecordStart(i);  // a training pass's first record (guiding.h)
-  g.queues.v[QUEUE_HEADER_UINTS + QUEUE_RAY0 * g.pathCapacity + i] = i;
+  g.queues.v[QUEUE_HEADER_UINTS + QUEUE_RAY0 * g.pathCapacity + cameraQueueSlot(i)] = i;
   if (i == 0u) {
     g.queues.v[QUEUE_RAY0] = g.chunkPaths;
     g.dispatchArgs.v[QUEUE_RAY0] = uvec4((g.chunkPaths + WORKGROUP_SIZE - 1u) / WORKGROUP_SIZE, 1u, 1u, 0u);

@@ -6,8 +6,8 @@
 //   (escape.comp), and end otherwise;
 // - the any-hit test of every shadow ray that shade(b - 1) queued (shadow queue (b - 1) & 1):
 //   unoccluded ones add their contribution to their path's radiance.
-// Workgroups [0, ceil(rays / WORKGROUP_SIZE)) take the rays, the following ones the shadow rays
-// (the dispatch size, ARGS_TRACE0 + (b & 1), counts both: queuePush). One dispatch and one barrier
+// Each half of the dispatch takes half of the ray workgroups, then half of the shadow ones (main;
+// the dispatch size, ARGS_TRACE0 + (b & 1), counts both: queuePush). One dispatch and one barrier
 // fewer per bounce than a shadow stage of its own; a workgroup is all of one kind, so no group
 // pays for both. Timed renders (--time-stages, bench render) dispatch the two kinds separately
 // (pc.traceMode) to report their GPU times apart.
@@ -58,6 +58,23 @@ void main() {
   uint rayGroups = 0u;
   if (pc.traceMode != TRACE_SHADOWS) rayGroups = (queueCount(rayQueue) + WORKGROUP_SIZE - 1u) / WORKGROUP_SIZE;
   uint group = gl_WorkGroupID.x;
+  if (pc.traceMode == TRACE_BOTH) {
+    // Each half of the dispatch takes half of the ray groups, then half of the shadow groups (the
+    // first half the first ones, which the queue shards fill from the pushes of the previous
+    // stage's first half): lavapipe's threads take contiguous halves of a dispatch, and rays
+    // first, shadow rays after left the thread with the closest hits busy long after the other
+    // (docs/performance.md, "Queue shards"). The dispatch counts the groups of both shards of
+    // both queues, so it can hold a few more groups than ceil(count / WORKGROUP_SIZE) of each
+    // kind; their lanes return in traceRay or traceShadow.
+    uint half0 = gl_NumWorkGroups.x / 2u;
+    uint rays0 = rayGroups / 2u;
+    uint h = group < half0 ? 0u : 1u;
+    uint p = group - h * half0;
+    uint raysHere = h == 0u ? rays0 : rayGroups - rays0;
+    if (p < raysHere) traceRay(rayQueue, (h * rays0 + p) * WORKGROUP_SIZE + gl_LocalInvocationID.x);
+    else traceShadow(shadowQueue, (h * (half0 - rays0) + p - raysHere) * WORKGROUP_SIZE + gl_LocalInvocationID.x);
+    return;
+  }
   if (group < rayGroups) traceRay(rayQueue, gl_GlobalInvocationID.x);
   else if (pc.traceMode != TRACE_RAYS) traceShadow(shadowQueue, (group - rayGroups) * WORKGROUP_SIZE + gl_LocalInvocationID.x);
 }

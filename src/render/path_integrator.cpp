@@ -227,9 +227,13 @@ void PathIntegrator::createPipelines() {
     if (!e.empty()) throw Error(e);
 }
 
+static_assert(QUEUE_COUNT <= QUEUE_SHARD_STRIDE && 2 * QUEUE_SHARD_STRIDE <= QUEUE_HEADER_UINTS,
+              "both shards' counters fit the queue header");
+
 void PathIntegrator::emptyQueues(VkCommandBuffer cmd, std::uint32_t first, std::uint32_t count) {
   if (count == 0) return;
   vkCmdFillBuffer(cmd, m_queues->buffer, first * 4, count * 4, 0);
+  vkCmdFillBuffer(cmd, m_queues->buffer, (QUEUE_SHARD_STRIDE + first) * 4, count * 4, 0);
   vkCmdFillBuffer(cmd, m_args->buffer, first * sizeof(DispatchArgs), count * sizeof(DispatchArgs), 0);
 }
 
