@@ -157,8 +157,8 @@ uint queueItem(uint queue, uint i) {
 // to its model's shade queue): the lanes pushing to the same queue as the first remaining lane
 // take one atomic together, then the others repeat (at most one round per distinct queue; one
 // atomic per subgroup and queue instead of one per lane, which halves the cost on lavapipe).
-// The same lane keeps the queue's indirect dispatch size current (ceil(count / WORKGROUP_SIZE)
-// workgroups, by atomicMax: counts only grow while a queue fills), so that no stage between
+// The same lane keeps the queue's indirect dispatch size current (each push adds the workgroups
+// it opens in its shard: ceil(count / WORKGROUP_SIZE) per shard), so that no stage between
 // producer and consumer has to turn counts into dispatch sizes (PathIntegrator::recordPass).
 void queuePush(uint queue, uint path) {
   for (int round = 0; round < 128; ++round) {
@@ -186,10 +186,10 @@ void queuePush(uint queue, uint path) {
           args.v[4u * queue + 1u] = 1u;
           args.v[4u * queue + 2u] = 1u;
           // The trace stage that consumes this queue runs the workgroups of its ray queue and of
-          // its shadow queue in one dispatch: each push adds the workgroups it opened (a shard's
-          // pushes' ranges are disjoint, so the additions sum to its ceil(count / WORKGROUP_SIZE)). Ray queue q
-          // feeds trace(b) with b & 1 = q; shadow queue s (filled at bounce b, s = b & 1) feeds
-          // trace(b + 1).
+          // its shadow queue in one dispatch: each push adds the workgroups it opened there too
+          // (a shard's pushes' ranges are disjoint, so they sum to its ceil(count /
+          // WORKGROUP_SIZE)). Ray queue q feeds trace(b) with b & 1 = q; shadow queue s (filled at
+          // bounce b, s = b & 1) feeds trace(b + 1).
           if (queue <= QUEUE_SHADOW1) {
             uint trace = ARGS_TRACE0 + (queue <= QUEUE_RAY1 ? queue : (queue - QUEUE_SHADOW0) ^ 1u);
             atomicAdd(args.v[4u * trace], opened);
