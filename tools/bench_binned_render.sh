@@ -25,7 +25,7 @@ bins=${BINS:-16}
 mkdir -p "$dir"
 # shellcheck source=tools/bench_lib.sh
 source tools/bench_lib.sh
-attr() { "$bin" info "$1" | sed -n "s/^  nusselt\/$2: //p" | head -1; }
+attr() { exr_attr "$bin" "$1" "$2"; }
 
 scene="$dir/textures-transmission.gltf"
 python3 - scenes/tests/textures.gltf "$scene" <<'PY'

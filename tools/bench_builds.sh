@@ -63,7 +63,7 @@ if [ "$mode" = render ]; then
     shift 4
     "$bin" render "$scene" --width 256 --height 256 --spp "$spp" --seed "$seed" -q --checkpoint 0 -o "$out" "$@" ||
       { echo "bench_builds.sh: $bin render $scene failed" >&2; exit 1; }
-    "$bin" info "$out" | sed -n 's/^  nusselt\/renderSeconds: //p'
+    exr_attr "$bin" "$out" renderSeconds
   }
   echo "Produced by \`tools/bench_builds.sh --render --repeats $repeats --spp $spp${*:+ -- $*}\` on $(date -u '+%Y-%m-%d %H:%M UTC'); $(nproc) cores, load average $(cut -d' ' -f1-3 /proc/loadavg) at the start; $name_a = $bin_a, $name_b = $bin_b. Render seconds (EXR header) of \`nusselt render\` (256 x 256, $spp spp, seeds 1-$repeats), runs in order, medians in bold; images: the two builds' renders of each seed compared."
   echo

@@ -45,7 +45,7 @@ common="--width $size --height $size --max-depth $depth -q --checkpoint 0"
 
 # shellcheck source=tools/bench_lib.sh
 source tools/bench_lib.sh
-attr() { "$bin" info "$1" | sed -n "s/^  nusselt\/$2: //p" | head -1; }
+attr() { exr_attr "$bin" "$1" "$2"; }
 
 echo "bench_integrator: $integrator against path, ${size}x${size}, --time $budget per run, reference $refSpp spp (path)," \
      "max depth $depth, $repeats repeats, $integrator with: ${ARGS:-(defaults)}${ARGS2:+; $integrator-2 with: $ARGS2}${ARGS3:+; $integrator-3 with: $ARGS3}"

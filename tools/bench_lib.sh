@@ -1,5 +1,6 @@
 # bench_lib.sh: shell functions shared by the interleaved A/B benchmark scripts of tools/
-# (bench_mlt.sh, bench_vegas.sh, bench_guiding.sh, bench_samples_per_pass.sh). Sourced, not run.
+# (bench_builds.sh, bench_integrator.sh, bench_mlt.sh, bench_vegas.sh, bench_guiding.sh, bench_binned_render.sh,
+# bench_samples_per_pass.sh). Sourced, not run.
 
 # calc EXPR: the arithmetic expression EXPR in awk (bc cannot read numbers printed as 1.5e-05,
 # which small relMSEs are).
@@ -24,3 +25,6 @@ bench_reference() {
   # shellcheck disable=SC2046
   "$bin" render $(scene_arg "$scene") "$@" --spp "$spp" --seed 1000 -o "$ref"
 }
+
+# exr_attr BIN FILE NAME: the value of the header attribute nusselt/NAME of FILE (`BIN info`).
+exr_attr() { "$1" info "$2" | sed -n "s/^  nusselt\/$3: //p" | head -1; }

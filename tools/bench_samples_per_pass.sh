@@ -21,7 +21,7 @@ for case in "64 256" "256 64"; do
     for k in 1 0; do
       "$bin" render --width "$size" --height "$size" --spp "$spp" --max-depth 16 --samples-per-pass $k \
         --checkpoint 0 -o "$work/k$k.exr" 2>"$work/log$k" </dev/null
-      "$bin" info "$work/k$k.exr" | awk '/nusselt\/renderSeconds/ { print $2 }' >>"$work/t$k"
+      exr_attr "$bin" "$work/k$k.exr" renderSeconds >>"$work/t$k"
     done
   done
   auto=$(sed -n 's/.*(\([0-9]*\) per pass).*/\1/p' "$work/log0")

@@ -144,6 +144,11 @@ const bool GUIDING = false;
 
 // ---- Queues ---------------------------------------------------------------------------------
 
+// Which half of its dispatch this workgroup is in (0 or 1): lavapipe gives each of its threads a
+// contiguous block of a dispatch's workgroups, so with two threads the halves are the threads'.
+// The queue shards (layout.h, "Queue ids") and the trace stage's split (intersect.comp) use it.
+uint dispatchHalf() { return gl_WorkGroupID.x >= gl_NumWorkGroups.x / 2u ? 1u : 0u; }
+
 uint queueCount(uint queue) { return g.queues.v[queue] + g.queues.v[QUEUE_SHARD_STRIDE + queue]; }
 
 // Item i < queueCount(queue): shard 0's items first, then shard 1's (layout.h, "Queue ids").
@@ -167,8 +172,7 @@ void queuePush(uint queue, uint path) {
       uvec4 ballot = subgroupBallot(true);
       uint n = subgroupBallotBitCount(ballot);
       uint rank = subgroupBallotExclusiveBitCount(ballot);
-      // The shard of this workgroup's half of the dispatch (layout.h, "Queue ids").
-      uint shard = gl_WorkGroupID.x >= gl_NumWorkGroups.x / 2u ? 1u : 0u;
+      uint shard = dispatchHalf();
       uint base = 0u;
       if (subgroupElect()) {
         base = atomicAdd(g.queues.v[shard * QUEUE_SHARD_STRIDE + queue], n);

@@ -66,9 +66,9 @@ void main() {
     // (docs/performance.md, "Queue shards"). The dispatch counts the groups of both shards of
     // both queues, so it can hold a few more groups than ceil(count / WORKGROUP_SIZE) of each
     // kind; their lanes return in traceRay or traceShadow.
-    uint half0 = gl_NumWorkGroups.x / 2u;
+    uint half0 = gl_NumWorkGroups.x / 2u;  // groups in half 0 (dispatchHalf)
     uint rays0 = rayGroups / 2u;
-    uint h = group < half0 ? 0u : 1u;
+    uint h = dispatchHalf();
     uint p = group - h * half0;
     uint raysHere = h == 0u ? rays0 : rayGroups - rays0;
     if (p < raysHere) traceRay(rayQueue, (h * rays0 + p) * WORKGROUP_SIZE + gl_LocalInvocationID.x);
