@@ -534,7 +534,7 @@ struct SampleToolConstants {
   uint count;
   uint first;
   uint seed;
-  uint reserved0;
+  uint idleLanes;  // lanes l of a subgroup with bit l set draw nothing (the tests' partial subgroups)
   vec4 v;
 };
 STATIC_ASSERT_SIZE(SampleToolConstants, 32);

@@ -269,9 +269,13 @@ SHARED_FN float quadAlbedo(uint set, float cosTheta, float phi) {
 
 // Inverse CDF of the density proportional to exp(k (t - 1/2)) on [0, 1]; k = 0 is uniform (the
 // builder sets |k| < QT_MIN_SLOPE to 0, so the formulas below never cancel badly).
-SHARED_FN float quadExpSample(float k, float u) {
+// m = exp(-|k|), which the rejection loop computes once per leaf (quadExpTail).
+SHARED_FN float quadExpTail(float k) { return exp(-abs(k)); }
+SHARED_FN float quadExpSample(float k, float m, float u) {
   if (k == 0.0f) return u;
-  float t = k > 0.0f ? 1.0f + portableLog(u + (1.0f - u) * exp(-k)) / k : portableLog((1.0f - u) + u * exp(k)) / k;
+  // One logarithm for either sign (exp(-k) = m for k > 0, exp(k) = m for k < 0).
+  float l = portableLog(k > 0.0f ? u + (1.0f - u) * m : (1.0f - u) + u * m);
+  float t = k > 0.0f ? 1.0f + l / k : l / k;
   return clamp(t, 0.0f, 1.0f);
 }
 // (cos, sin) of pi t for t in [-2, 2], reduced so that t = 0, +-1, +-2 give sin = 0 exactly: the
@@ -359,22 +363,20 @@ SHARED_FN bool quadDescend(uint root, bool aniso, float u, uvec4 stream, OUT(Qua
 
 // ---- Rejection in the leaf ------------------------------------------------------------------------
 
-// Draws the canonical direction wc (mirrored when d says so) in the leaf d reached, with density
-// proportional to f(., vk) over the leaf's region (disc measure), and returns fl = the luminance
-// of f there (at the unmirrored point: the same value, f being symmetric). Rejection in the same
-// leaf (restarting at the root would break proportionality): a trial draws a point from the
-// proposal (density proportional to the envelope e); points outside the leaf's region are
-// discarded before f is evaluated; the others are accepted with probability f / e. Trial t draws
-// from pcg4d(stream + (0, 0, 0, t)). False after QT_MAX_TRIALS rejected trials (counted as a trial
-// failure); samples that saw f > e are counted as bound violations. side = -1: a lower-disc tree
-// (QT_SET_TRANSMITS): f is evaluated at, and wc returned as, the point below the surface.
-SHARED_FN bool quadLeafSample(uint model, BrdfParams p, vec3 vk, QuadDescent d, uvec4 stream, float side, OUT(vec3) wc,
-                              OUT(float) fl) {
-  wc = vec3(0.0f);
-  fl = 0.0f;
-  uint link = d.link;
-  float x0 = d.box.x, x1 = d.box.y, y0 = d.box.z, y1 = d.box.w;
-  QuadLeaf L = QT_LEAF(link & ~QT_LEAF_BIT);
+// The proposal of a leaf, as its trials read it: the leaf's envelope and box (quadtree_layout.h,
+// QuadLeaf) with what every trial would otherwise recompute (exp(-|k|) of the slopes; the polar
+// box's squared cosines, powers and mixture weight), and the side of the disc.
+struct QuadProposal {
+  vec4 box;   // the descent's square (x0, x1, y0, y1)
+  vec4 pbox;  // polar: (c0^2, c1^2, t0, t1) = (u0, u1, p0, p1)
+  vec4 env;   // (A, k1, k2, B)
+  vec4 aux;   // (exp(-|k1|), exp(-|k2|), s, pE: probability of the exponential part)
+  vec4 rim;   // (g0, g1: c0^(2 - s), c1^(2 - s), side, kind as a float)
+};
+STATIC_ASSERT_SIZE(QuadProposal, 80);
+
+SHARED_FN QuadProposal quadLeafProposal(QuadDescent d, float side) {
+  QuadLeaf L = QT_LEAF(d.link & ~QT_LEAF_BIT);
   uint kind = uint(L.data.z + 0.5f);
   float A = L.data.x;
   float s = L.data.w;
@@ -386,8 +388,6 @@ SHARED_FN bool quadLeafSample(uint model, BrdfParams p, vec3 vk, QuadDescent d, 
   // (c^2, phi) times its slopes, the cos^-s part has disc density ~ c^-s: c^(2-s) uniform.
   float c0 = L.box.x;
   float c1 = L.box.y;
-  float p0 = L.box.z;
-  float p1 = L.box.w;
   float u0 = c0 * c0;
   float u1 = c1 * c1;
   float pE = 1.0f;
@@ -400,63 +400,249 @@ SHARED_FN bool quadLeafSample(uint model, BrdfParams p, vec3 vk, QuadDescent d, 
     float wB = B * (g1 - g0) / (2.0f - s);
     pE = wE / (wE + wB);
   }
+  QuadProposal q;
+  q.box = d.box;
+  q.pbox = vec4(u0, u1, L.box.z, L.box.w);
+  q.env = vec4(A, k1, k2, B);
+  q.aux = vec4(quadExpTail(k1), quadExpTail(k2), s, pE);
+  q.rim = vec4(g0, g1, side, float(kind));
+  return q;
+}
 
-  bool accepted = false;
-  bool violated = false;
-  uint trial = 0u;
-  uint evaluations = 0u;
-  for (; trial < QT_MAX_TRIALS; ++trial) {
-    uvec4 h = pcg4d(uvec4(stream.x, stream.y, stream.z, stream.w + trial));
-    float a = float(h.x >> 8u) * (1.0f / 16777216.0f);
-    float b = float(h.y >> 8u) * (1.0f / 16777216.0f);
-    float cc = float(h.z >> 8u) * (1.0f / 16777216.0f);
-    float cm = float(h.w >> 8u) * (1.0f / 16777216.0f);
-    float x, y, co, t1, t2;
-    if (polar) {
-      if (cm < pE) {
-        t1 = quadExpSample(k1, a);
-        t2 = quadExpSample(k2, b);
-        co = sqrt(mix(u0, u1, t1));
-      } else {
-        co = pow(mix(g0, g1, a), 1.0f / (2.0f - s));
-        t1 = clamp((co * co - u0) / (u1 - u0), 0.0f, 1.0f);
-        t2 = b;
-      }
-      if (co <= 0.0f) continue;
-      float r = cosFromSin(co);
-      vec2 cs = quadCosSinPi(mix(p0, p1, t2));
-      x = r * cs.x;
-      y = r * cs.y;
-      if (kind == QT_PROPOSAL_POLAR_CUT && (x < x0 || x > x1 || y < y0 || y > y1)) continue;
+// Trial `trial` of the rejection in a leaf: a point wc drawn from the proposal with
+// pcg4d(stream + (0, 0, 0, trial)), discarded when outside the leaf's region (evaluated = false),
+// else fl = the luminance of f(wc, vk) and e the envelope there; true when accepted (f / e).
+SHARED_FN bool quadTrial(uint model, BrdfParams p, vec3 vk, QuadProposal q, uvec4 stream, uint trial, OUT(vec3) wc,
+                         OUT(float) fl, OUT(float) e, OUT(bool) evaluated) {
+  wc = vec3(0.0f);
+  fl = 0.0f;
+  e = 0.0f;
+  evaluated = false;
+  uint kind = uint(q.rim.w);
+  bool polar = kind != QT_PROPOSAL_SQUARE;
+  float s = q.aux.z;
+  float k1 = q.env.y;
+  float k2 = q.env.z;
+  float B = q.env.w;
+  uvec4 h = pcg4d(uvec4(stream.x, stream.y, stream.z, stream.w + trial));
+  float a = float(h.x >> 8u) * (1.0f / 16777216.0f);
+  float b = float(h.y >> 8u) * (1.0f / 16777216.0f);
+  float cc = float(h.z >> 8u) * (1.0f / 16777216.0f);
+  float cm = float(h.w >> 8u) * (1.0f / 16777216.0f);
+  float x = 0.0f;
+  float y = 0.0f;
+  float co;
+  bool inside = true;
+  // The exponential proposal of the square and of the polar box's first part: computed once for
+  // both kinds (lavapipe runs every branch body that some lane of the subgroup takes).
+  float t1 = quadExpSample(k1, q.aux.x, a);
+  float t2 = quadExpSample(k2, q.aux.y, b);
+  if (polar) {
+    float u0 = q.pbox.x;
+    float u1 = q.pbox.y;
+    if (cm < q.aux.w) {
+      co = sqrt(mix(u0, u1, t1));
     } else {
-      t1 = quadExpSample(k1, a);
-      t2 = quadExpSample(k2, b);
-      x = mix(x0, x1, t1);
-      y = mix(y0, y1, t2);
-      float r2 = x * x + y * y;
-      if (r2 >= 1.0f) continue;
-      co = cosFromSin(sqrt(r2));
+      co = pow(mix(q.rim.x, q.rim.y, a), 1.0f / (2.0f - s));
+      t1 = clamp((co * co - u0) / (u1 - u0), 0.0f, 1.0f);
+      t2 = b;
     }
-    if (co <= 0.0f) continue;
-    float e = A * exp(k1 * (t1 - 0.5f) + k2 * (t2 - 0.5f));
-    if (B > 0.0f) e += B * pow(co, -s);
-    wc = vec3(x, y, side * co);
-    fl = quadEvalLum(model, p, wc, vk);
-    ++evaluations;
-    if (fl > e) {
-      violated = true;
-      QT_REPORT_VIOLATION(link & ~QT_LEAF_BIT, wc, fl, e);
-    }
-    if (cc * e < fl) { accepted = true; break; }
+    if (co <= 0.0f) inside = false;
+    float r = cosFromSin(co);
+    vec2 cs = quadCosSinPi(mix(q.pbox.z, q.pbox.w, t2));
+    x = r * cs.x;
+    y = r * cs.y;
+    if (kind == QT_PROPOSAL_POLAR_CUT && (x < q.box.x || x > q.box.y || y < q.box.z || y > q.box.w)) inside = false;
+  } else {
+    x = mix(q.box.x, q.box.y, t1);
+    y = mix(q.box.z, q.box.w, t2);
+    float r2 = x * x + y * y;
+    if (r2 >= 1.0f) inside = false;
+    co = cosFromSin(sqrt(r2));
   }
-  QT_COUNT_TRIALS(evaluations, trial + 1u, d.depth, link & ~QT_LEAF_BIT, accepted);
+  if (!(inside && co > 0.0f)) return false;
+  e = q.env.x * exp(k1 * (t1 - 0.5f) + k2 * (t2 - 0.5f));
+  if (B > 0.0f) e += B * pow(co, -s);
+  wc = vec3(x, y, q.rim.z * co);
+  fl = quadEvalLum(model, p, wc, vk);
+  evaluated = true;
+  return cc * e < fl;
+}
+
+// The end of a leaf's rejection (serial or shared): its counters, and the accepted point mirrored
+// when the descent says so.
+SHARED_FN bool quadLeafSampleEnd(bool violated, bool accepted, uint mirrored, INOUT(vec3) wc) {
   if (violated) QT_COUNT_BOUND_VIOLATION();
   if (!accepted) {
     QT_COUNT_TRIAL_FAILURE();
     return false;
   }
-  if (d.mirrored != 0u) wc.y = -wc.y;
+  if (mirrored != 0u) wc.y = -wc.y;
   return true;
+}
+
+// Draws the canonical direction wc (mirrored when d says so) in the leaf d reached, with density
+// proportional to f(., vk) over the leaf's region (disc measure), and returns fl = the luminance
+// of f there (at the unmirrored point: the same value, f being symmetric). Rejection in the same
+// leaf (restarting at the root would break proportionality): a trial draws a point from the
+// proposal (density proportional to the envelope e); points outside the leaf's region are
+// discarded before f is evaluated; the others are accepted with probability f / e. Trial t draws
+// from pcg4d(stream + (0, 0, 0, t)): the sample is the first accepted trial. False after
+// QT_MAX_TRIALS rejected trials (counted as a trial failure); samples that saw f > e in a trial
+// up to the accepted one are counted as bound violations. side = -1: a lower-disc tree
+// (QT_SET_TRANSMITS): f is evaluated at, and wc returned as, the point below the surface.
+// With subgroups (GLSL stages that define NUSSELT_SUBGROUPS) and a model whose evaluation is
+// costly (modelCostlyEval), the lanes share the trials (quadLeafSampleShared below): the same
+// first accepted trial, in fewer rounds.
+SHARED_FN bool quadLeafSampleSerial(uint model, BrdfParams p, vec3 vk, QuadDescent d, QuadProposal q, uvec4 stream,
+                                    OUT(vec3) wc, OUT(float) fl) {
+  wc = vec3(0.0f);
+  fl = 0.0f;
+  uint link = d.link;
+  bool accepted = false;
+  bool violated = false;
+  uint trial = 0u;
+  uint evaluations = 0u;
+  for (; trial < QT_MAX_TRIALS; ++trial) {
+    vec3 w;
+    float f;
+    float e;
+    bool evaluated;
+    bool ok = quadTrial(model, p, vk, q, stream, trial, w, f, e, evaluated);
+    if (!evaluated) continue;
+    ++evaluations;
+    wc = w;
+    fl = f;
+    if (f > e) {
+      violated = true;
+      QT_REPORT_VIOLATION(link & ~QT_LEAF_BIT, w, f, e);
+    }
+    if (ok) { accepted = true; break; }
+  }
+  QT_COUNT_TRIALS(evaluations, trial + 1u, d.depth, link & ~QT_LEAF_BIT, accepted);
+  return quadLeafSampleEnd(violated, accepted, d.mirrored, wc);
+}
+
+#if !defined(__cplusplus) && defined(NUSSELT_SUBGROUPS)
+// Shared trials. A lane whose sample is accepted early would idle while the subgroup's slowest
+// lane goes on trying (lavapipe and GPUs run a loop until its last lane leaves): every round,
+// each lane runs one trial for one of the samples still open instead, the open samples dealt
+// round-robin over the lanes (lane rank r works for open sample r mod k, on that sample's trial
+// next + r / k). A sample takes the first accepted of its trials in trial order, which is the
+// accepted trial of the serial loop: the same point, bit for bit. The lanes exchange the sample's
+// proposal, parameters and stream with subgroupShuffle (on lavapipe one vpermd per component).
+// Subgroups of at most 32 lanes (one word of the ballots); wider ones run the serial loop.
+
+// The lane of the n-th (from 0) set bit of m; full: m has the subgroup's every lane (then lane n).
+uint quadNthLane(uint m, uint n, bool full) {
+  if (full) return n;
+  for (uint i = 0u; i < n && i < 32u; ++i) m &= m - 1u;
+  return uint(findLSB(m));
+}
+QuadProposal quadShuffleProposal(QuadProposal q, uint lane) {
+  QuadProposal r;
+  r.box = subgroupShuffle(q.box, lane);
+  r.pbox = subgroupShuffle(q.pbox, lane);
+  r.env = subgroupShuffle(q.env, lane);
+  r.aux = subgroupShuffle(q.aux, lane);
+  r.rim = subgroupShuffle(q.rim, lane);
+  return r;
+}
+BrdfParams quadShuffleParams(BrdfParams p, uint lane) {
+  BrdfParams r;
+  for (uint i = 0u; i < uint(BRDF_PARAM_VEC4S); ++i) r.v[i] = subgroupShuffle(p.v[i], lane);
+  return r;
+}
+
+bool quadLeafSampleShared(uint model, BrdfParams p, vec3 vk, QuadDescent d, QuadProposal q, uvec4 stream,
+                          OUT(vec3) wc, OUT(float) fl) {
+  wc = vec3(0.0f);
+  fl = 0.0f;
+  uint lane = gl_SubgroupInvocationID;
+  uint members = subgroupBallot(true).x;
+  uint nMembers = bitCount(members);
+  bool full = nMembers == gl_SubgroupSize;
+  uint rank = bitCount(members & ((1u << lane) - 1u));
+  bool done = false;
+  bool accepted = false;
+  bool violated = false;
+  uint next = 0u;  // the next trial of this lane's sample
+  for (uint round = 0u; round < QT_MAX_TRIALS; ++round) {
+    uint open = subgroupBallot(!done).x;
+    uint k = bitCount(open);
+    if (k == 0u) break;
+    // The open sample this lane works for, and its trial.
+    bool own = k == nMembers;  // every sample open (the first round): each lane its own
+    uint target = own ? lane : quadNthLane(open, rank % k, k == gl_SubgroupSize);
+    uint trial;
+    QuadProposal tq;
+    BrdfParams tp;
+    vec3 tvk;
+    uvec4 ts;
+    if (own) {
+      trial = next;
+      tq = q;
+      tp = p;
+      tvk = vk;
+      ts = stream;
+    } else {
+      trial = subgroupShuffle(next, target) + rank / k;
+      tq = quadShuffleProposal(q, target);
+      tp = quadShuffleParams(p, target);
+      tvk = subgroupShuffle(vk, target);
+      ts = subgroupShuffle(stream, target);
+    }
+    vec3 tw = vec3(0.0f);
+    float tf = 0.0f;
+    float te = 0.0f;
+    bool evaluated = false;
+    bool ok = false;
+    if (trial < QT_MAX_TRIALS) ok = quadTrial(model, tp, tvk, tq, ts, trial, tw, tf, te, evaluated);
+    uint okMask = subgroupBallot(ok).x;
+    uint violMask = subgroupBallot(evaluated && tf > te).x;
+    // This lane's sample, if open: its workers are the member lanes of rank openRank + i k, in
+    // the order of their trials.
+    uint winner = lane;
+    bool justAccepted = false;
+    if (!done) {
+      uint openRank = own ? rank : bitCount(open & ((1u << lane) - 1u));
+      uint count = own ? 1u : (nMembers - openRank + k - 1u) / k;
+      bool found = false;
+      for (uint i = 0u; i < count && !found; ++i) {
+        uint w = own ? lane : quadNthLane(members, openRank + i * k, full);
+        if (((violMask >> w) & 1u) != 0u) violated = true;
+        if (((okMask >> w) & 1u) != 0u) {
+          found = true;
+          winner = w;
+        }
+      }
+      if (found) {
+        done = true;
+        accepted = true;
+        justAccepted = true;
+      } else {
+        next += count;
+        if (next >= QT_MAX_TRIALS) done = true;
+      }
+    }
+    vec3 ww = subgroupShuffle(tw, winner);
+    float wf = subgroupShuffle(tf, winner);
+    if (justAccepted) {
+      wc = ww;
+      fl = wf;
+    }
+  }
+  return quadLeafSampleEnd(violated, accepted, d.mirrored, wc);
+}
+#endif
+
+SHARED_FN bool quadLeafSample(uint model, BrdfParams p, vec3 vk, QuadDescent d, uvec4 stream, float side, OUT(vec3) wc,
+                              OUT(float) fl) {
+  QuadProposal q = quadLeafProposal(d, side);
+#if !defined(__cplusplus) && defined(NUSSELT_SUBGROUPS)
+  if (modelCostlyEval(model) && gl_SubgroupSize <= 32u) return quadLeafSampleShared(model, p, vk, d, q, stream, wc, fl);
+#endif
+  return quadLeafSampleSerial(model, p, vk, d, q, stream, wc, fl);
 }
 
 // ---- Sampling -------------------------------------------------------------------------------------

@@ -7,6 +7,8 @@
 #extension GL_KHR_shader_subgroup_ballot : require
 #extension GL_KHR_shader_subgroup_shuffle : require
 #extension GL_KHR_shader_subgroup_vote : require
+// Shared code may use the subgroup operations above (quadtree.h: shared rejection trials).
+#define NUSSELT_SUBGROUPS 1
 #ifdef NUSSELT_RAY_QUERY
 #extension GL_EXT_ray_query : require
 #endif

@@ -106,7 +106,7 @@ SampleBatch sampleCpuStrategy(std::uint32_t strategy, const sampling::TabulatedT
 SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32_t set, std::uint32_t model,
                       const BrdfParams& params, vec3 v, std::uint32_t n, std::uint32_t seed, std::uint32_t strategy,
                       const sampling::TabulatedTables* tab, bool warmUp, std::uint32_t timingRepeats,
-                      std::uint32_t timingCount, const RoughnessBins* bins) {
+                      std::uint32_t timingCount, const RoughnessBins* bins, std::uint32_t idleLanes) {
   if (strategy == SAMPLER_TABULATED && !tab) throw std::invalid_argument("sampleGpu: tabulated needs its tables");
   SampleBatch out;
   auto upload = [&](const void* data, std::size_t bytes, const char* what) {
@@ -163,6 +163,7 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
 
   SampleToolConstants pc{};
   pc.seed = seed;
+  pc.idleLanes = idleLanes;
   pc.v = vec4(v, 0.0f);
   if (warmUp) {  // lavapipe compiles the shader at its first dispatch: keep that out of the timing
     pc.count = std::min<std::uint32_t>(n, WORKGROUP_SIZE);

@@ -53,7 +53,10 @@ SampleBatch sampleGpu(vk::Context& ctx, const SamplerTables& tables, std::uint32
                       const shared::BrdfParams& params, shared::vec3 v, std::uint32_t n, std::uint32_t seed,
                       std::uint32_t strategy = SAMPLER_QUADTREE, const sampling::TabulatedTables* tab = nullptr,
                       bool warmUp = false, std::uint32_t timingRepeats = 0,
-                      std::uint32_t timingCount = std::uint32_t(1) << 20, const shared::RoughnessBins* bins = nullptr);
+                      std::uint32_t timingCount = std::uint32_t(1) << 20, const shared::RoughnessBins* bins = nullptr,
+                      std::uint32_t idleLanes = 0);
+// idleLanes: subgroup lanes l with bit l set draw nothing (fOk.w = -1 there): partial subgroups, as
+// the shade stages have, for the tests of the quadtree's shared trials (quadtree.h).
 // bins (quadtree only, model gltf_pbr): binned sampling (bsdf_sampling.h, binnedSample) of the texel
 // parameters `params` with the bins' sets bins->first .. of `tables` (the sample tool's BINNED
 // specialization, constant 2); `set` is unused then.

@@ -30,6 +30,13 @@ SHARED_FN bool modelTransmits(uint model) {
          (ROUGH_THIN_DIELECTRIC_TRANSMITS != 0 && model == MODEL_ROUGH_THIN_DIELECTRIC);
 }
 
+// Models whose evaluation costs an order of magnitude more than the others' (measured in `nusselt
+// bench error`'s cosine column, which evaluates f once per sample: htsg ~170 ns, poulin_fournier
+// ~175 ns, every other model 7-25 ns on lavapipe): htsg sums a series, poulin_fournier integrates
+// its cylinder profile. The quadtree's rejection shares its trials across a subgroup for them
+// (quadtree.h, quadLeafSampleShared), where fewer rounds of evaluations pay for the exchange.
+SHARED_FN bool modelCostlyEval(uint model) { return model == MODEL_HTSG || model == MODEL_POULIN_FOURNIER; }
+
 // The offset of a model's `tint` parameter (the colour of the light it transmits at each crossing:
 // glTF's base colour on KHR_materials_transmission), or INVALID_INDEX for a model without one.
 SHARED_FN uint modelTintParam(uint model) {
