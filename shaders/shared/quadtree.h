@@ -269,7 +269,7 @@ SHARED_FN float quadAlbedo(uint set, float cosTheta, float phi) {
 
 // Inverse CDF of the density proportional to exp(k (t - 1/2)) on [0, 1]; k = 0 is uniform (the
 // builder sets |k| < QT_MIN_SLOPE to 0, so the formulas below never cancel badly).
-// m = exp(-|k|), which the rejection loop computes once per leaf (quadExpTail).
+// m = exp(-|k|) (quadExpTail), computed once per sample for its leaf (quadLeafProposal), not per trial.
 SHARED_FN float quadExpTail(float k) { return exp(-abs(k)); }
 SHARED_FN float quadExpSample(float k, float m, float u) {
   if (k == 0.0f) return u;
