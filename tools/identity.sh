@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Bit-identity check for refactors: renders a fixed set of small cases (every sampler, lighting
 # mode, random-number mode (the default qmc, and pcg) and roulette on the Cornell box; the
-# materials scene; the test scenes; combined materials; the dragon) and compares them with a
+# materials scene; the test scenes; combined materials; Metropolis and VEGAS; the dragon) and compares them with a
 # recorded set. A refactor must leave
 # every pixel and every counter of the header unchanged.
 #
@@ -41,6 +41,10 @@ cases=(
   "combined-albedo-roulette|scenes/tests/combined.gltf $small --roulette albedo"
   "combined-uniform|scenes/tests/combined.gltf $small --components uniform"
   "combined-uniform-albedo|scenes/tests/combined.gltf $small --components uniform --roulette albedo"
+  "cornell-mlt|$small --integrator mlt --mlt-chains 4096"
+  "cornell-mlt-direct-in-chain|$small --integrator mlt --mlt-chains 4096 --mlt-direct-spp 0 --mlt-weights plain"
+  "glass-mlt|scenes/cornell/cornell-glass.glb $small --integrator mlt --mlt-chains 2048"
+  "cornell-vegas|$small --integrator vegas"
   "dragon|scenes/dragon/dragon.gltf --width 32 --height 32 --spp 2 --max-depth 4 -q --checkpoint 0"
 )
 counters='nusselt/(rays|shadowRays|nonFiniteSamples|bvhStackOverflows|samplerBoundViolations|samplerTrialFailures|spp):'

@@ -94,6 +94,15 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 #define RADIANCE_ALL 0u
 #define RADIANCE_DIRECT 1u
 #define RADIANCE_INDIRECT 2u
+// Globals.primaryFresh: a Metropolis pass (mlt.h) need not store every draw of a path's primary
+// sample vector; the draws it leaves out are hashes the stages compute where they read them
+// (mltFreshSample), the values the mlt kernels would have stored. NONE: every draw below
+// primaryDims is in primarySamples (VEGAS, the chains' starts, direct light). POOL: none is (a
+// bootstrap path's draws, mltPoolSample). MUTATE: slot c stores its first GpuMlt.written[c]
+// draws, the rest are the step's fresh draws (mltLargeStep of mltHash).
+#define PRIMARY_FRESH_NONE 0u
+#define PRIMARY_FRESH_POOL 1u
+#define PRIMARY_FRESH_MUTATE 2u
 
 // ---- Material flags ---------------------------------------------------------------------------------
 #define MATERIAL_EMISSIVE 1u
@@ -372,7 +381,9 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer Environment
 // radiance L (rgb), its pixel as float bits); splats: per pixel 6 uints (r, g, b: low, high);
 // poolF: f of every bootstrap path; start: the pool path each chain starts from; counters:
 // MLT_COUNTERS uints, per pass; extent: per chain, the draws its current path read (mltExtent of
-// the path's bounces, mlt.h): a small step moves those and draws the rest fresh.
+// the path's bounces, mlt.h): a small step moves those and draws the rest fresh; written: per
+// chain, the draws of its proposal the mutation stored in primarySamples (PRIMARY_FRESH_MUTATE: the
+// others are fresh, computed where they are read).
 struct GpuMlt {
   uvec4 info;
   uvec4 pool;
@@ -392,7 +403,7 @@ struct GpuMlt {
   BUFREF(Uints) start;
   BUFREF(Uints) counters;
   BUFREF(Uints) extent;
-  uvec2 reserved;  // std430 rounds the struct to 16 bytes
+  BUFREF(Uints) written;
 };
 STATIC_ASSERT_SIZE(GpuMlt, 144);
 #ifndef __cplusplus
@@ -498,7 +509,7 @@ struct Globals {
   // The roughness bins of the scene's textured gltf_pbr materials (MATERIAL_BINNED; count 0: none).
   RoughnessBins roughnessBins;
   uint radiancePart;     // RADIANCE_*: every contribution (the default), or only direct or indirect light
-  uint reservedG;
+  uint primaryFresh;     // PRIMARY_FRESH_*: which draws of a path's vector are not stored (stage_common.glsl, pathSample2)
 };
 STATIC_ASSERT_SIZE(Globals, 80 + 6 * 16 + 40 * 8 + 8 + 16 + 8);
 // The tabulated strategy's buffers exist (shaders/shared/bsdf_sampling.h compiles it in GLSL).

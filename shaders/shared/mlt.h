@@ -13,24 +13,28 @@
 #ifndef NUSSELT_MLT_H
 #define NUSSELT_MLT_H
 #include "prelude.h"
+#include "layout.h"
 #include "rng.h"
 SHARED_BEGIN
 
 // The kernels of the mlt stage (specialization constant 13 of shaders/stages/mlt.comp).
-#define MLT_KERNEL_POOL 0u     // path slot c gets the vector of bootstrap path poolFirst + c
-#define MLT_KERNEL_START 1u    // path slot c gets the vector of bootstrap path start[c] (chain c's start)
-#define MLT_KERNEL_RECORD 2u   // pool[poolFirst + c] = f of the path slot c traced
-#define MLT_KERNEL_ADOPT 3u    // chain c's state = the path slot c traced (its start), no splat
-#define MLT_KERNEL_MUTATE 4u   // path slot c gets chain c's proposal
-#define MLT_KERNEL_ACCEPT 5u   // splat current and proposal, accept or reject
-#define MLT_KERNEL_RESOLVE 6u  // the pass's splats into the film
+// A bootstrap chunk needs no kernel before its trace: its paths' draws are all fresh
+// (PRIMARY_FRESH_POOL: slot c draws those of bootstrap path poolFirst + c where it reads them).
+#define MLT_KERNEL_START 0u    // path slot c gets the vector of bootstrap path start[c] (chain c's start)
+#define MLT_KERNEL_RECORD 1u   // pool[poolFirst + c] = f of the path slot c traced
+#define MLT_KERNEL_ADOPT 2u    // chain c's state = the path slot c traced (its start), no splat
+#define MLT_KERNEL_MUTATE 3u   // path slot c gets chain c's proposal (the draws it moves; the rest fresh)
+#define MLT_KERNEL_ACCEPT 4u   // splat current and proposal, accept or reject
+#define MLT_KERNEL_RESOLVE 5u  // the pass's splats into the film
 // Direct light outside the chain: pixels pool.x .. pool.x + pool.y - 1, direct.z samples each
 // (numbers direct.x + k): path slot k x pool.y + c gets the vector of sample k of pixel pool.x + c
 // (a camera draw uniform in that pixel, the rest hashed), traced for direct light only; then
 // invocation c adds its pixel's samples / direct.y to the film, in sample order (no atomics).
-#define MLT_KERNEL_DIRECT 7u
-#define MLT_KERNEL_DIRECT_ADD 8u
-#define MLT_KERNELS 9u
+#define MLT_KERNEL_DIRECT 6u
+#define MLT_KERNEL_DIRECT_ADD 7u
+#define MLT_KERNELS 8u
+// No kernel (MltIntegrator::traceBetween).
+#define MLT_KERNEL_NONE 0xffffffffu
 // Splats are sums of fixed-point integers (2^24 units per unit of luminance-normalised radiance),
 // 64 bits per channel (two uints with carry): integer addition commutes, so the image does not
 // depend on the order in which chains splat (same seed, same image, bit for bit).
@@ -93,6 +97,11 @@ SHARED_FN vec2 mltSmallStep(vec2 u, uvec4 h, float sigma) {
 // a short path never reads.
 SHARED_FN uint mltExtent(uint bounces, uint dims) { return min(rngDimension(bounces, 0u), dims); }
 
+// The draws of a chain's vector that matter: those an unguided path may read (rng.h; mlt renders
+// are never guided). The others are never read, so a step neither moves nor keeps them: in law a
+// Gibbs redraw (as for the draws beyond the extent, above), and no work.
+SHARED_FN bool mltReadsDraw(uint dimension) { return rngReadUnguided(dimension); }
+
 // The large step's draw: fresh uniforms from h.z, h.w.
 SHARED_FN vec2 mltLargeStep(uvec4 h) { return vec2(mltUnit(h.z), mltUnit(h.w)); }
 
@@ -100,6 +109,15 @@ SHARED_FN vec2 mltLargeStep(uvec4 h) { return vec2(mltUnit(h.z), mltUnit(h.w)); 
 // current path did not read: mltExtent) or moved by the small step.
 SHARED_FN vec2 mltPropose(vec2 u, uvec4 h, bool fresh, float sigma) {
   return fresh ? mltLargeStep(h) : mltSmallStep(u, h, sigma);
+}
+
+// A fresh draw that a pass leaves out of the path slots' vectors (layout.h, PRIMARY_FRESH_*), as
+// the stages compute it where they read it and the mlt kernels where they keep it: POOL, draw
+// `dimension` of bootstrap path key.x with the bootstrap's seed key.y (mltPoolSample); MUTATE, the
+// step's fresh draw of chain `slot` at iteration key.x with the render's seed key.y (mltLargeStep).
+SHARED_FN vec2 mltFreshSample(uint mode, uint slot, uint dimension, uvec2 key) {
+  if (mode == PRIMARY_FRESH_POOL) return mltPoolSample(key.x, dimension, key.y);
+  return mltLargeStep(mltHash(slot, key.x, dimension, key.y));
 }
 
 SHARED_END

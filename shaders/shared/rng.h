@@ -19,10 +19,22 @@ SHARED_BEGIN
 #define RNG_DIM_COMPONENT 6u
 #define RNG_DIM_GUIDE 7u         // and 8: path guiding's choice of the guide, its tree descent
 #define RNG_DIM_GUIDE_CELL 9u    // and 10: the point in the guide's chosen cell
+// The slots a bounce of an unguided path reads (a 1-D draw reads its slot's x): a draw in another
+// slot is never read, which Metropolis uses (mlt.h, mltReadsDraw). A new slot that unguided paths
+// read goes here (test PrimaryRender.DrawsOutsideTheReadSlotsAreNotRead replaces the others).
+#define RNG_SLOTS_UNGUIDED ((1u << RNG_DIM_LIGHT_SELECT) | (1u << RNG_DIM_LIGHT_POINT) | (1u << RNG_DIM_BSDF) | \
+                            (1u << RNG_DIM_ROULETTE) | (1u << RNG_DIM_COMPONENT))
 // The quadtree sampler's stream of further numbers (rngStreamKey).
 #define RNG_REJECTION_STREAM 0x80000000u
 
 SHARED_FN uint rngDimension(uint bounce, uint slot) { return 2u + bounce * RNG_DIMS_PER_BOUNCE + slot; }
+
+// Whether an unguided path may read draw `dimension`: the camera's draw 0 (draw 1 is not read) and
+// the slots RNG_SLOTS_UNGUIDED of each bounce.
+SHARED_FN bool rngReadUnguided(uint dimension) {
+  return dimension == 0u ||
+         (dimension >= 2u && ((RNG_SLOTS_UNGUIDED >> ((dimension - 2u) % RNG_DIMS_PER_BOUNCE)) & 1u) != 0u);
+}
 
 // pcg4d (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 9(3), 2020).
 SHARED_FN uvec4 pcg4d(uvec4 v) {

@@ -30,6 +30,7 @@
 
 #include "shared/layout.h"
 #include "shared/rng.h"
+#include "shared/mlt.h"
 #include "shared/warp.h"
 #include "shared/texture.h"
 #include "shared/volume.h"
@@ -50,22 +51,43 @@ const bool PRIMARY_SAMPLES = false;
 #endif
 
 // The key of one path sample: its pixel and sample index, the render's mode and seed, and the
-// path's slot (the index of its state and of its primary samples).
+// path's slot (the index of its state and of its primary samples). With PRIMARY_SAMPLES, the
+// draws of the slot's vector that are stored (the first `written`; all of them unless the pass
+// leaves some out, Globals.primaryFresh) and the key of the others (mltFreshSample).
 struct PathKey {
   uint rngMode;
   uint pixel;
   uint sampleIndex;
   uint seed;
   uint path;
+  uint written;
+  uvec2 freshKey;
 };
+
+PathKey makePathKey(uint pixel, uint sampleIndex, uint path) {
+  PathKey k = PathKey(g.rngMode, pixel, sampleIndex, g.seed, path, 0xffffffffu, uvec2(0u));
+  if (PRIMARY_SAMPLES && g.primaryFresh != PRIMARY_FRESH_NONE) {
+    Mlts mlt = g.mlt;
+    if (g.primaryFresh == PRIMARY_FRESH_POOL) {
+      uvec4 pool = mlt.v[0].pool;
+      k.written = 0u;
+      k.freshKey = uvec2(pool.x + path, pool.w);
+    } else {
+      k.written = mlt.v[0].written.v[path];
+      k.freshKey = uvec2(mlt.v[0].info.z, g.seed);
+    }
+  }
+  return k;
+}
 
 PathKey pathKey(uint path) {
   uvec4 info = loadUVec4(g.pathInfo, path);
-  return PathKey(g.rngMode, info.x, info.y, g.seed, path);
+  return makePathKey(info.x, info.y, path);
 }
 
 vec2 pathSample2(PathKey k, uint dimension) {
   if (PRIMARY_SAMPLES && dimension < g.primaryDims) {
+    if (dimension >= k.written) return mltFreshSample(g.primaryFresh, k.path, dimension, k.freshKey);
     Vec2s p = g.primarySamples;
     return p.v[primarySampleIndex(k.path, dimension, g.primaryDims)];
   }

@@ -38,7 +38,7 @@ void main() {
   uint py = pixel / width;
 
   // Pixel jitter: dimensions 0 and 1 (box filter over the pixel).
-  vec2 u = pathSample2(PathKey(g.rngMode, pixel, sampleIndex, g.seed, i), 0u);
+  vec2 u = pathSample2(makePathKey(pixel, sampleIndex, i), 0u);
   if (IMAGE_SAMPLES) {
     vec2 xy = u * vec2(float(width), float(g.height));
     px = min(uint(xy.x), width - 1u);

@@ -40,9 +40,9 @@ void main() {
   uint iteration = m.info.z;
   Vec2s primary = g.primarySamples;
 
-  if (MLT_KERNEL == MLT_KERNEL_POOL || MLT_KERNEL == MLT_KERNEL_START) {
-    if (c >= (MLT_KERNEL == MLT_KERNEL_POOL ? m.pool.y : chains)) return;
-    uint i = MLT_KERNEL == MLT_KERNEL_POOL ? m.pool.x + c : m.start.v[c];
+  if (MLT_KERNEL == MLT_KERNEL_START) {
+    if (c >= chains) return;
+    uint i = m.start.v[c];
     for (uint d = 0u; d < dims; ++d) primary.v[primarySampleIndex(c, d, dims)] = mltPoolSample(i, d, m.pool.w);
   } else if (MLT_KERNEL == MLT_KERNEL_RECORD) {
     if (c >= m.pool.y) return;
@@ -50,19 +50,23 @@ void main() {
   } else if (MLT_KERNEL == MLT_KERNEL_ADOPT) {
     if (c >= chains) return;
     uint extent = mltExtent(g.pathInfo.v[c].z, dims);
-    for (uint d = 0u; d < extent; ++d) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];
+    for (uint d = 0u; d < extent; ++d)
+      if (mltReadsDraw(d)) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];
     m.state.v[c] = vec4(tracedRadiance(c), uintBitsToFloat(g.pathInfo.v[c].x));
     m.extent.v[c] = extent;
   } else if (MLT_KERNEL == MLT_KERNEL_MUTATE) {
     if (c >= chains) return;
     bool large = mltUnit(mltHash(c, iteration, MLT_DIM_STEP, g.seed).x) < m.params.x;
     // A small step moves the draws the current path read and draws the rest fresh (mltExtent).
+    // Only the moved draws are stored: the stages compute the fresh ones where they read them
+    // (PRIMARY_FRESH_MUTATE, mltFreshSample), and most are never read.
     uint moved = large ? 0u : m.extent.v[c];
-    for (uint d = 0u; d < dims; ++d) {
+    for (uint d = 0u; d < moved; ++d) {
+      if (!mltReadsDraw(d)) continue;
       uint at = primarySampleIndex(c, d, dims);
-      uvec4 h = mltHash(c, iteration, d, g.seed);
-      primary.v[at] = mltPropose(d < moved ? m.current.v[at] : vec2(0.0f), h, d >= moved, m.params.y);
+      primary.v[at] = mltSmallStep(m.current.v[at], mltHash(c, iteration, d, g.seed), m.params.y);
     }
+    m.written.v[c] = moved;
   } else if (MLT_KERNEL == MLT_KERNEL_ACCEPT) {
     bool live = c < chains;
     bool large = false, accepted = false;
@@ -92,7 +96,13 @@ void main() {
       accepted = mltUnit(h.y) < a;
       if (accepted) {  // the draws the new path read: the next step draws the others fresh
         uint extent = mltExtent(g.pathInfo.v[c].z, dims);
-        for (uint d = 0u; d < extent; ++d) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];
+        uint written = min(m.written.v[c], extent);
+        for (uint d = 0u; d < extent; ++d) {
+          if (!mltReadsDraw(d)) continue;
+          uint at = primarySampleIndex(c, d, dims);
+          if (d < written) m.current.v[at] = primary.v[at];
+          else m.current.v[at] = mltFreshSample(PRIMARY_FRESH_MUTATE, c, d, uvec2(iteration, g.seed));
+        }
         m.state.v[c] = vec4(Lp, uintBitsToFloat(pp));
         m.extent.v[c] = extent;
       }

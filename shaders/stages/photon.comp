@@ -16,7 +16,7 @@ void main() {
   uint i = gl_GlobalInvocationID.x;
   if (i >= g.chunkPaths) return;
   uint photon = g.chunkFirst + i;
-  PathKey key = PathKey(g.rngMode, photon, g.sampleIndex, g.seed, i);
+  PathKey key = makePathKey(photon, g.sampleIndex, i);
   g.pathInfo.v[i] = uvec4(photon, g.sampleIndex, 0u, 0u);
   g.pathRadiance.v[i] = vec4(0.0f);
   if (g.lightCount == 0u) return;

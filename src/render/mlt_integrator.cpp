@@ -16,9 +16,9 @@ using shared::Globals;
 
 std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t dims, std::uint32_t bootstrap,
                                       std::uint64_t pixels) {
-  // Current vectors, states, start indices, extents; splat sums; the bootstrap's f values (and the chunk of
+  // Current vectors, states, start indices, extents, stored draws; splat sums; the bootstrap's f values (and the chunk of
   // b' for Kelemen's weights); GpuMlt, counters.
-  return std::uint64_t(shared::primarySampleSlots(chains)) * dims * 8ull + std::uint64_t(chains) * 28 + pixels * 24 +
+  return std::uint64_t(shared::primarySampleSlots(chains)) * dims * 8ull + std::uint64_t(chains) * 32 + pixels * 24 +
          std::uint64_t(bootstrap) * 4 + 256;
 }
 
@@ -45,6 +45,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m_poolF = make((std::uint64_t(m_poolSize) + m_chains) * 4, "mlt bootstrap");
   m_start = make(std::uint64_t(m_chains) * 4, "mlt chain starts");
   vk::Buffer* extent = make(std::uint64_t(m_chains) * 4, "mlt chain extents");
+  vk::Buffer* written = make(std::uint64_t(m_chains) * 4, "mlt stored draws");
   m_counters = make(MLT_COUNTERS * 4, "mlt counters", true);
   std::memset(m_counters->mapped, 0, MLT_COUNTERS * 4);
   GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
@@ -59,6 +60,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m.start = m_start->address;
   m.counters = m_counters->address;
   m.extent = extent->address;
+  m.written = written->address;
   m.direct = {0u, settings.mltDirectSpp, 0u, 0u};
   globals.host().mlt = m_mlt->address;
 
@@ -80,6 +82,7 @@ void MltIntegrator::bootstrap(std::uint32_t firstSample) {
                        : shared::pcg4d(glm::uvec4(m_settings.seed, firstSample, MLT_STREAM_POOL, 0x85ebca6bu)).x;
   m.pool.w = seed;
   g.radiancePart = chainPart();  // b and the starts are of the chains' f
+  g.primaryFresh = PRIMARY_FRESH_POOL;  // a pool path's draws are hashes of its index
   g.chunkFirst = 0;
   g.passSamples = 1;
   g.sampleIndex = 0;
@@ -90,7 +93,7 @@ void MltIntegrator::bootstrap(std::uint32_t firstSample) {
     m.pool.y = count;
     g.chunkPaths = count;
     m_globals.upload();
-    traceBetween(MLT_KERNEL_POOL, MLT_KERNEL_RECORD, count);
+    traceBetween(MLT_KERNEL_NONE, MLT_KERNEL_RECORD, count);
   }
   std::vector<float>& f = m_poolValues;
   f.resize(m_poolSize);
@@ -119,6 +122,7 @@ void MltIntegrator::bootstrap(std::uint32_t firstSample) {
     }
     vk::uploadBuffer(m_ctx, *m_start, start.data(), std::uint64_t(m_chains) * 4);
     g.chunkPaths = m_chains;
+    g.primaryFresh = PRIMARY_FRESH_NONE;  // MLT_KERNEL_START stores the starts' draws
     m_globals.upload();
     traceBetween(MLT_KERNEL_START, MLT_KERNEL_ADOPT, m_chains);
   }
@@ -131,8 +135,9 @@ void MltIntegrator::bootstrap(std::uint32_t firstSample) {
     m.pool.x = m_poolSize;
     m.pool.y = m_chains;
     g.chunkPaths = m_chains;
+    g.primaryFresh = PRIMARY_FRESH_POOL;
     m_globals.upload();
-    traceBetween(MLT_KERNEL_POOL, MLT_KERNEL_RECORD, m_chains);
+    traceBetween(MLT_KERNEL_NONE, MLT_KERNEL_RECORD, m_chains);
     std::vector<float> fb(m_chains);
     vk::downloadBuffer(m_ctx, *m_poolF, fb.data(), std::uint64_t(m_chains) * 4, std::uint64_t(m_poolSize) * 4);
     double sum = 0;
@@ -153,7 +158,7 @@ void MltIntegrator::bootstrap(std::uint32_t firstSample) {
 
 void MltIntegrator::traceBetween(std::uint32_t before, std::uint32_t after, std::uint32_t n) {
   VkCommandBuffer cmd = begin();
-  dispatch(cmd, before, n);
+  if (before != MLT_KERNEL_NONE) dispatch(cmd, before, n);
   m_paths->recordTrace(cmd, n);
   vk::computeBarrier(cmd);
   dispatch(cmd, after, n);
@@ -174,6 +179,7 @@ void MltIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples)
   Globals& g = m_globals.host();
   GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
   g.radiancePart = chainPart();
+  g.primaryFresh = PRIMARY_FRESH_MUTATE;  // a proposal stores only its moved draws
   g.chunkFirst = 0;
   g.chunkPaths = m_chains;
   g.passSamples = 1;
@@ -206,6 +212,7 @@ void MltIntegrator::directPass(std::uint32_t sampleIndex, std::uint32_t samples)
   // Pixels per trace (at most the path slots), and as many samples of each as the slots hold.
   const std::uint32_t pixelsPerTrace = static_cast<std::uint32_t>(std::min<std::uint64_t>(m_chains, m_pixels));
   g.radiancePart = RADIANCE_DIRECT;
+  g.primaryFresh = PRIMARY_FRESH_NONE;  // MLT_KERNEL_DIRECT stores the draws a direct path reads
   g.chunkFirst = 0;
   g.passSamples = 1;
   for (std::uint32_t k = 0; k < total;) {

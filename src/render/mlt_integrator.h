@@ -76,8 +76,8 @@ class MltIntegrator : public PrimarySampleIntegrator {
   // (0: the seed itself), so that a resumed render's chains restart independently of the first
   // segment's.
   void bootstrap(std::uint32_t firstSample);
-  // One submission: kernel `before` over n chains, the path tracer's trace of their paths, then
-  // kernel `after` (the pool, the chains' starts, every step).
+  // One submission: kernel `before` (or none: MLT_KERNEL_NONE) over n chains, the path tracer's
+  // trace of their paths, then kernel `after` (the pool, the chains' starts, every step).
   void traceBetween(std::uint32_t before, std::uint32_t after, std::uint32_t n);
   void readCounters();
   // The part of a path's radiance that is the chains' f (RADIANCE_*: all, or indirect light when

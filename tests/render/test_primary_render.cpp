@@ -132,3 +132,71 @@ TEST(PrimaryRender, DrawsBeyondTheRecordedExtentAreNotRead) {
               shortPaths, slots, s.maxDepth, changed, changedLast, lit);
   EXPECT_EQ(test::validationMessages(), 0u);
 }
+
+// Metropolis moves and keeps only the draws an unguided path may read (rng.h, rngReadUnguided:
+// the camera's draw 0 and the slots RNG_SLOTS_UNGUIDED of each bounce; mlt.h, mltReadsDraw). Here
+// every other draw of every path slot is replaced and the paths must not change, bit for bit, on
+// scenes whose paths read each slot: the Cornell box (light sample, cosine sampler, roulette),
+// combined materials (the component choice, mirror and glass) and the glossy Cornell box (gltf_pbr's
+// quadtree sampler, whose rejection stream is keyed on its primary draws). Not void: replacing the
+// first bounce's BSDF draw changes most paths that scatter there.
+TEST(PrimaryRender, DrawsOutsideTheReadSlotsAreNotRead) {
+  for (const std::string file : {std::string(), std::string("scenes/tests/combined.gltf"),
+                                 std::string("scenes/cornell/cornell-glossy.glb")}) {
+    SCOPED_TRACE(file.empty() ? "default scene" : file);
+    Scene scene = file.empty() ? loadSceneOrDefault("", "") : test::loadTestScene(file);
+    RenderSettings s;
+    s.width = 16;
+    s.height = 16;
+    s.spp = 1;
+    s.samplesPerPass = 1;
+    s.maxDepth = 6;
+    s.seed = 7;
+    s.primarySamples = true;
+    Renderer r(test::context(), scene, s);
+    PathIntegrator& paths = r.paths();
+    const std::uint32_t dims = PathIntegrator::primaryDimsFor(s.maxDepth);
+    const std::uint32_t slots = s.width * s.height;
+    std::mt19937 prng(23);
+    auto fresh = [&] { return glm::vec2(float(prng() >> 8), float(prng() >> 8)) * (1.0f / 16777216.0f); };
+    std::vector<glm::vec2> u(std::size_t(shared::primarySampleSlots(paths.capacity())) * dims);
+    for (glm::vec2& x : u) x = fresh();
+    auto trace = [&](const std::vector<glm::vec2>& v, std::vector<glm::vec4>& L, std::vector<glm::uvec4>& info) {
+      vk::uploadBuffer(test::context(), paths.primarySamples(), v.data(), v.size() * 8);
+      r.renderPass(1);
+      L.resize(slots);
+      info.resize(slots);
+      vk::downloadBuffer(test::context(), paths.pathRadiance(), L.data(), slots * 16);
+      vk::downloadBuffer(test::context(), paths.pathInfo(), info.data(), slots * 16);
+    };
+    std::vector<glm::vec4> L0, L1, L2;
+    std::vector<glm::uvec4> info0, info1, info2;
+    trace(u, L0, info0);
+    std::vector<glm::vec2> unread = u, bsdf = u;
+    std::uint32_t replaced = 0, scattered = 0, deep = 0;
+    for (std::uint32_t i = 0; i < slots; ++i) {
+      for (std::uint32_t d = 0; d < dims; ++d)
+        if (!shared::mltReadsDraw(d)) {
+          unread[shared::primarySampleIndex(i, d, dims)] = fresh();
+          ++replaced;
+        }
+      scattered += info0[i].z > 0;
+      deep += info0[i].z >= 3;  // past the bounces before the roulette starts
+      bsdf[shared::primarySampleIndex(i, shared::rngDimension(0, RNG_DIM_BSDF), dims)] = fresh();
+    }
+    trace(unread, L1, info1);
+    int changed = 0;
+    for (std::uint32_t i = 0; i < slots; ++i) changed += std::memcmp(&L0[i], &L1[i], 12) != 0 || info0[i].z != info1[i].z;
+    EXPECT_EQ(changed, 0) << "a draw outside the read slots changed the path";
+    trace(bsdf, L2, info2);
+    int changedBsdf = 0;
+    for (std::uint32_t i = 0; i < slots; ++i) changedBsdf += std::memcmp(&L0[i], &L2[i], 12) != 0 || info0[i].z != info2[i].z;
+    EXPECT_GE(changedBsdf, int(scattered) / 2) << "the first bounce's BSDF draw seems unread";
+    // Not void: paths reach the roulette's bounces, so its slot and the later ones are read.
+    EXPECT_GE(deep, slots / 8);
+    std::printf("%u draws replaced; paths changed: %d; %u of %u paths scatter, %u reach bounce 3; replacing the first "
+                "BSDF draw changed %d\n",
+                replaced, changed, scattered, slots, deep, changedBsdf);
+  }
+  EXPECT_EQ(test::validationMessages(), 0u);
+}
