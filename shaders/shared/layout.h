@@ -97,12 +97,14 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 // Globals.primaryFresh: a Metropolis pass (mlt.h) need not store every draw of a path's primary
 // sample vector; the draws it leaves out are hashes the stages compute where they read them
 // (mltFreshSample), the values the mlt kernels would have stored. NONE: every draw below
-// primaryDims is in primarySamples (VEGAS, the chains' starts, direct light). POOL: none is (a
-// bootstrap path's draws, mltPoolSample). MUTATE: slot c stores its first GpuMlt.written[c]
-// draws, the rest are the step's fresh draws (mltLargeStep of mltHash).
+// primaryDims is in primarySamples (VEGAS, the chains' starts). POOL: none is (a bootstrap path's
+// draws, mltPoolSample). MUTATE: slot c's proposal stores its first GpuMlt.written[c] draws, in
+// one of the chains' two vector buffers (MLT_SIDE_B of written[c]), the rest are the step's fresh
+// draws (mltLargeStep of mltHash). DIRECT: none is (a direct-light sample's, mltDirectDraw).
 #define PRIMARY_FRESH_NONE 0u
 #define PRIMARY_FRESH_POOL 1u
 #define PRIMARY_FRESH_MUTATE 2u
+#define PRIMARY_FRESH_DIRECT 3u
 
 // ---- Material flags ---------------------------------------------------------------------------------
 #define MATERIAL_EMISSIVE 1u
@@ -377,13 +379,17 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer Environment
 // pool = (first pool path of this bootstrap chunk, paths in it, pool size, 0);
 // params = (large-step probability, small-step sigma, resolve scale (b x pixels / chains /
 // MLT_FIXED_SCALE), iterations in this pass (the film's sample count)).
-// current: the chains' current vectors (primarySampleIndex(c, d, dims)); state: per chain (its current
-// radiance L (rgb), its pixel as float bits); splats: per pixel 6 uints (r, g, b: low, high);
+// vectorsB: the second of the chains' two vector buffers (primarySampleIndex(c, d, dims); the
+// first is Globals.primarySamples): a chain's current vector is in one, its proposal goes into the
+// other, and an accepted proposal becomes the current vector where it is (no copy). state: per
+// chain (its current radiance L (rgb), its pixel as float bits); splats: per pixel 6 uints (r, g,
+// b: low, high);
 // poolF: f of every bootstrap path; start: the pool path each chain starts from; counters:
 // MLT_COUNTERS uints, per pass; extent: per chain, the draws its current path read (mltExtent of
-// the path's bounces, mlt.h): a small step moves those and draws the rest fresh; written: per
-// chain, the draws of its proposal the mutation stored in primarySamples (PRIMARY_FRESH_MUTATE: the
-// others are fresh, computed where they are read).
+// the path's bounces, mlt.h; a small step moves those and draws the rest fresh), with MLT_SIDE_B
+// when its current vector is in vectorsB; written: per chain, the draws of its proposal the
+// mutation stored (PRIMARY_FRESH_MUTATE: the others are fresh, computed where they are read), with
+// MLT_SIDE_B when the proposal is in vectorsB.
 struct GpuMlt {
   uvec4 info;
   uvec4 pool;
@@ -396,7 +402,7 @@ struct GpuMlt {
   // direct sample of this trace, direct samples per pixel per iteration, direct samples per pixel
   // in this trace, 0); y = 0: direct light in the chain.
   uvec4 direct;
-  BUFREF(Vec2s) current;
+  BUFREF(Vec2s) vectorsB;
   BUFREF(Vec4s) state;
   BUFREF(Uints) splats;
   BUFREF(Floats) poolF;
@@ -573,7 +579,7 @@ layout(set = 0, binding = 0, std430) readonly buffer GlobalsBlock { Globals g; }
 #endif
 
 // Where draw `dimension` of path slot `path` lives in Globals.primarySamples (and a Metropolis
-// chain's current vector, GpuMlt.current) of `dims` draws per path: blocks of 8 paths (a
+// chain's second vector buffer, GpuMlt.vectorsB) of `dims` draws per path: blocks of 8 paths (a
 // subgroup on lavapipe), each block's draws one after the other, the 8 paths' values of a draw
 // side by side. Neighbouring lanes read neighbouring memory and one lane's draws stay within a
 // few KiB (one plane per dimension thrashed the TLB: 2-3x slower mutations on lavapipe).

@@ -27,12 +27,12 @@ SHARED_BEGIN
 #define MLT_KERNEL_ACCEPT 4u   // splat current and proposal, accept or reject
 #define MLT_KERNEL_RESOLVE 5u  // the pass's splats into the film
 // Direct light outside the chain: pixels pool.x .. pool.x + pool.y - 1, direct.z samples each
-// (numbers direct.x + k): path slot k x pool.y + c gets the vector of sample k of pixel pool.x + c
-// (a camera draw uniform in that pixel, the rest hashed), traced for direct light only; then
-// invocation c adds its pixel's samples / direct.y to the film, in sample order (no atomics).
-#define MLT_KERNEL_DIRECT 6u
-#define MLT_KERNEL_DIRECT_ADD 7u
-#define MLT_KERNELS 8u
+// (numbers direct.x + k): path slot k x pool.y + c traces sample k of pixel pool.x + c (a camera
+// draw uniform in that pixel, the rest hashed: PRIMARY_FRESH_DIRECT, no kernel before the trace)
+// for direct light only; then invocation c adds its pixel's samples / direct.y to the film, in
+// sample order (no atomics).
+#define MLT_KERNEL_DIRECT_ADD 6u
+#define MLT_KERNELS 7u
 // No kernel (MltIntegrator::traceBetween).
 #define MLT_KERNEL_NONE 0xffffffffu
 // Splats are sums of fixed-point integers (2^24 units per unit of luminance-normalised radiance),
@@ -41,6 +41,10 @@ SHARED_BEGIN
 #define MLT_FIXED_SCALE 16777216.0f
 // Counters (GpuMlt.counters): proposals, accepted, large-step proposals, large steps accepted.
 #define MLT_COUNTERS 4u
+// GpuMlt.extent and .written: the bit that says the vector is in the second buffer (vectorsB), and
+// the count below it.
+#define MLT_SIDE_B 0x80000000u
+#define MLT_COUNT 0x7fffffffu
 // The draws of a step that are not a coordinate (large or small, accept): dimension index.
 #define MLT_DIM_STEP 0xffffffffu
 // Streams of the hash (the fourth key component): chains' mutations, the bootstrap pool, chain starts.
@@ -68,6 +72,14 @@ SHARED_FN vec2 mltPoolSample(uint i, uint dimension, uint seed) {
 SHARED_FN vec2 mltDirectSample(uint pixel, uint number, uint dimension, uint seed) {
   uvec4 h = pcg4d(uvec4(pixel, number, dimension, seed ^ (MLT_STREAM_DIRECT << 16u)));
   return vec2(mltUnit(h.x), mltUnit(h.y));
+}
+
+// Draw `dimension` of direct sample `number` of a pixel of an image of `size`: draw 0 places the
+// ray on the image (camera.comp, IMAGE_SAMPLES) uniformly within the pixel.
+SHARED_FN vec2 mltDirectDraw(uint pixel, uint number, uint dimension, uint seed, uvec2 size) {
+  vec2 u = mltDirectSample(pixel, number, dimension, seed);
+  if (dimension == 0u) u = (vec2(float(pixel % size.x), float(pixel / size.x)) + u) / vec2(float(size.x), float(size.y));
+  return u;
 }
 
 // x wrapped into [0, 1) (x - floor(x) rounds to 1 for tiny negative x: that is 0 on the circle).
@@ -115,6 +127,7 @@ SHARED_FN vec2 mltPropose(vec2 u, uvec4 h, bool fresh, float sigma) {
 // the stages compute it where they read it and the mlt kernels where they keep it: POOL, draw
 // `dimension` of bootstrap path key.x with the bootstrap's seed key.y (mltPoolSample); MUTATE, the
 // step's fresh draw of chain `slot` at iteration key.x with the render's seed key.y (mltLargeStep).
+// (DIRECT: mltDirectDraw, which needs the image's size.)
 SHARED_FN vec2 mltFreshSample(uint mode, uint slot, uint dimension, uvec2 key) {
   if (mode == PRIMARY_FRESH_POOL) return mltPoolSample(key.x, dimension, key.y);
   return mltLargeStep(mltHash(slot, key.x, dimension, key.y));

@@ -52,7 +52,8 @@ const bool PRIMARY_SAMPLES = false;
 
 // The key of one path sample: its pixel and sample index, the render's mode and seed, and the
 // path's slot (the index of its state and of its primary samples). With PRIMARY_SAMPLES, the
-// draws of the slot's vector that are stored (the first `written`; all of them unless the pass
+// buffer that holds the slot's vector (Globals.primarySamples, or a Metropolis chain's second
+// buffer), the draws of it that are stored (the first `written`; all of them unless the pass
 // leaves some out, Globals.primaryFresh) and the key of the others (mltFreshSample).
 struct PathKey {
   uint rngMode;
@@ -62,18 +63,24 @@ struct PathKey {
   uint path;
   uint written;
   uvec2 freshKey;
+  Vec2s vectors;
 };
 
 PathKey makePathKey(uint pixel, uint sampleIndex, uint path) {
-  PathKey k = PathKey(g.rngMode, pixel, sampleIndex, g.seed, path, 0xffffffffu, uvec2(0u));
+  PathKey k = PathKey(g.rngMode, pixel, sampleIndex, g.seed, path, 0xffffffffu, uvec2(0u), g.primarySamples);
   if (PRIMARY_SAMPLES && g.primaryFresh != PRIMARY_FRESH_NONE) {
     Mlts mlt = g.mlt;
+    k.written = 0u;
     if (g.primaryFresh == PRIMARY_FRESH_POOL) {
       uvec4 pool = mlt.v[0].pool;
-      k.written = 0u;
       k.freshKey = uvec2(pool.x + path, pool.w);
+    } else if (g.primaryFresh == PRIMARY_FRESH_DIRECT) {
+      uvec4 pool = mlt.v[0].pool;
+      k.freshKey = uvec2(pool.x + path % pool.y, mlt.v[0].direct.x + path / pool.y);
     } else {
-      k.written = mlt.v[0].written.v[path];
+      uint w = mlt.v[0].written.v[path];
+      k.written = w & MLT_COUNT;
+      if ((w & MLT_SIDE_B) != 0u) k.vectors = mlt.v[0].vectorsB;
       k.freshKey = uvec2(mlt.v[0].info.z, g.seed);
     }
   }
@@ -87,9 +94,12 @@ PathKey pathKey(uint path) {
 
 vec2 pathSample2(PathKey k, uint dimension) {
   if (PRIMARY_SAMPLES && dimension < g.primaryDims) {
-    if (dimension >= k.written) return mltFreshSample(g.primaryFresh, k.path, dimension, k.freshKey);
-    Vec2s p = g.primarySamples;
-    return p.v[primarySampleIndex(k.path, dimension, g.primaryDims)];
+    if (dimension >= k.written) {
+      if (g.primaryFresh == PRIMARY_FRESH_DIRECT)
+        return mltDirectDraw(k.freshKey.x, k.freshKey.y, dimension, g.seed, uvec2(g.width, g.height));
+      return mltFreshSample(g.primaryFresh, k.path, dimension, k.freshKey);
+    }
+    return k.vectors.v[primarySampleIndex(k.path, dimension, g.primaryDims)];
   }
   return sample2(k.rngMode, k.pixel, k.sampleIndex, dimension, k.seed);
 }

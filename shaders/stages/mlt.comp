@@ -49,24 +49,27 @@ void main() {
     m.poolF.v[m.pool.x + c] = luminance(tracedRadiance(c));
   } else if (MLT_KERNEL == MLT_KERNEL_ADOPT) {
     if (c >= chains) return;
-    uint extent = mltExtent(g.pathInfo.v[c].z, dims);
-    for (uint d = 0u; d < extent; ++d)
-      if (mltReadsDraw(d)) m.current.v[primarySampleIndex(c, d, dims)] = primary.v[primarySampleIndex(c, d, dims)];
+    // The start's vector stays where MLT_KERNEL_START put it (primarySamples): the current vector.
     m.state.v[c] = vec4(tracedRadiance(c), uintBitsToFloat(g.pathInfo.v[c].x));
-    m.extent.v[c] = extent;
+    m.extent.v[c] = mltExtent(g.pathInfo.v[c].z, dims);
   } else if (MLT_KERNEL == MLT_KERNEL_MUTATE) {
     if (c >= chains) return;
     bool large = mltUnit(mltHash(c, iteration, MLT_DIM_STEP, g.seed).x) < m.params.x;
     // A small step moves the draws the current path read and draws the rest fresh (mltExtent).
     // Only the moved draws are stored: the stages compute the fresh ones where they read them
     // (PRIMARY_FRESH_MUTATE, mltFreshSample), and most are never read.
-    uint moved = large ? 0u : m.extent.v[c];
+    // The proposal goes into the buffer that does not hold the current vector.
+    uint e = m.extent.v[c];
+    bool currentB = (e & MLT_SIDE_B) != 0u;
+    Vec2s current = currentB ? m.vectorsB : primary;
+    Vec2s proposal = currentB ? primary : m.vectorsB;
+    uint moved = large ? 0u : e & MLT_COUNT;
     for (uint d = 0u; d < moved; ++d) {
       if (!mltReadsDraw(d)) continue;
       uint at = primarySampleIndex(c, d, dims);
-      primary.v[at] = mltSmallStep(m.current.v[at], mltHash(c, iteration, d, g.seed), m.params.y);
+      proposal.v[at] = mltSmallStep(current.v[at], mltHash(c, iteration, d, g.seed), m.params.y);
     }
-    m.written.v[c] = moved;
+    m.written.v[c] = moved | (currentB ? 0u : MLT_SIDE_B);
   } else if (MLT_KERNEL == MLT_KERNEL_ACCEPT) {
     bool live = c < chains;
     bool large = false, accepted = false;
@@ -94,35 +97,23 @@ void main() {
         if (fc > 0.0f && a < 1.0f) splat(m, floatBitsToUint(state.w), Lc * ((1.0f - a) / fc));
       }
       accepted = mltUnit(h.y) < a;
-      if (accepted) {  // the draws the new path read: the next step draws the others fresh
+      if (accepted) {
+        // The proposal becomes the current vector in its buffer; of the draws the new path read
+        // (the next step draws the others fresh), those the mutation did not store are stored now.
         uint extent = mltExtent(g.pathInfo.v[c].z, dims);
-        uint written = min(m.written.v[c], extent);
-        for (uint d = 0u; d < extent; ++d) {
-          if (!mltReadsDraw(d)) continue;
-          uint at = primarySampleIndex(c, d, dims);
-          if (d < written) m.current.v[at] = primary.v[at];
-          else m.current.v[at] = mltFreshSample(PRIMARY_FRESH_MUTATE, c, d, uvec2(iteration, g.seed));
-        }
+        uint w = m.written.v[c];
+        Vec2s proposal = (w & MLT_SIDE_B) != 0u ? m.vectorsB : primary;
+        for (uint d = w & MLT_COUNT; d < extent; ++d)
+          if (mltReadsDraw(d))
+            proposal.v[primarySampleIndex(c, d, dims)] = mltFreshSample(PRIMARY_FRESH_MUTATE, c, d, uvec2(iteration, g.seed));
         m.state.v[c] = vec4(Lp, uintBitsToFloat(pp));
-        m.extent.v[c] = extent;
+        m.extent.v[c] = extent | (w & MLT_SIDE_B);
       }
     }
     count(m, 0u, live);
     count(m, 1u, accepted);
     count(m, 2u, live && large);
     count(m, 3u, accepted && large);
-  } else if (MLT_KERNEL == MLT_KERNEL_DIRECT) {
-    if (c >= m.pool.y * m.direct.z) return;
-    uint pixel = m.pool.x + c % m.pool.y;
-    uint number = m.direct.x + c / m.pool.y;
-    // A direct-light path reads the draws of its first two vertices (the shade stage ends it there).
-    uint extent = mltExtent(2u, dims);
-    for (uint d = 0u; d < extent; ++d) {
-      vec2 u = mltDirectSample(pixel, number, d, g.seed);
-      // Draw 0 places the ray on the image (camera.comp, IMAGE_SAMPLES): uniform within the pixel.
-      if (d == 0u) u = (vec2(float(pixel % g.width), float(pixel / g.width)) + u) / vec2(float(g.width), float(g.height));
-      primary.v[primarySampleIndex(c, d, dims)] = u;
-    }
   } else if (MLT_KERNEL == MLT_KERNEL_DIRECT_ADD) {
     if (c >= m.pool.y) return;
     vec3 sum = vec3(0.0f);

@@ -16,7 +16,7 @@ using shared::Globals;
 
 std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t dims, std::uint32_t bootstrap,
                                       std::uint64_t pixels) {
-  // Current vectors, states, start indices, extents, stored draws; splat sums; the bootstrap's f values (and the chunk of
+  // The second vector buffer, states, start indices, extents, stored draws; splat sums; the bootstrap's f values (and the chunk of
   // b' for Kelemen's weights); GpuMlt, counters.
   return std::uint64_t(shared::primarySampleSlots(chains)) * dims * 8ull + std::uint64_t(chains) * 32 + pixels * 24 +
          std::uint64_t(bootstrap) * 4 + 256;
@@ -39,7 +39,8 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m_report.bootstrapPaths = m_poolSize;
   auto make = [&](VkDeviceSize bytes, const std::string& what, bool host = false) { return makeBuffer(bytes, what, host); };
   m_mlt = make(sizeof(GpuMlt), "mlt state", true);
-  vk::Buffer* current = make(std::uint64_t(shared::primarySampleSlots(m_chains)) * m_dims * 8, "mlt current vectors");
+  // The chains' second vector buffer (the first is the path tracer's primarySamples).
+  vk::Buffer* vectorsB = make(std::uint64_t(shared::primarySampleSlots(m_chains)) * m_dims * 8, "mlt vectors");
   vk::Buffer* state = make(std::uint64_t(m_chains) * 16, "mlt chain states");
   m_splats = make(m_pixels * 24, "mlt splats");
   m_poolF = make((std::uint64_t(m_poolSize) + m_chains) * 4, "mlt bootstrap");
@@ -53,7 +54,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m.info = {m_chains, m_dims, 0u, static_cast<std::uint32_t>(m_pixels)};
   m.pool = {0u, 0u, m_poolSize, settings.seed};
   m.params = {settings.mltLargeStep, settings.mltSigma, 0.0f, 0.0f};
-  m.current = current->address;
+  m.vectorsB = vectorsB->address;
   m.state = state->address;
   m.splats = m_splats->address;
   m.poolF = m_poolF->address;
@@ -212,7 +213,7 @@ void MltIntegrator::directPass(std::uint32_t sampleIndex, std::uint32_t samples)
   // Pixels per trace (at most the path slots), and as many samples of each as the slots hold.
   const std::uint32_t pixelsPerTrace = static_cast<std::uint32_t>(std::min<std::uint64_t>(m_chains, m_pixels));
   g.radiancePart = RADIANCE_DIRECT;
-  g.primaryFresh = PRIMARY_FRESH_NONE;  // MLT_KERNEL_DIRECT stores the draws a direct path reads
+  g.primaryFresh = PRIMARY_FRESH_DIRECT;  // a direct sample's draws are hashes of its pixel and number
   g.chunkFirst = 0;
   g.passSamples = 1;
   for (std::uint32_t k = 0; k < total;) {
@@ -228,7 +229,7 @@ void MltIntegrator::directPass(std::uint32_t sampleIndex, std::uint32_t samples)
       m.pool.y = count;
       g.chunkPaths = count * per;
       m_globals.upload();
-      traceBetween(MLT_KERNEL_DIRECT, MLT_KERNEL_DIRECT_ADD, count * per);
+      traceBetween(MLT_KERNEL_NONE, MLT_KERNEL_DIRECT_ADD, count * per);
     }
     k += per;
   }
