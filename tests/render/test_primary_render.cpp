@@ -68,6 +68,45 @@ TEST(PrimaryRender, SameVectorSamePathOtherVectorOtherPath) {
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
+// 16 x 16 paths of one sample each (slot i: pixel i) that read their draws from primary sample
+// vectors we choose: traced from a set of vectors, their radiance and path info per slot.
+struct Replay {
+  static RenderSettings settings(std::uint32_t maxDepth, std::uint32_t seed) {
+    RenderSettings s;
+    s.width = 16;
+    s.height = 16;
+    s.spp = 1;
+    s.samplesPerPass = 1;
+    s.maxDepth = maxDepth;
+    s.seed = seed;
+    s.primarySamples = true;
+    return s;
+  }
+  Replay(const Scene& scene, std::uint32_t maxDepth, std::uint32_t seed, std::uint32_t prngSeed)
+      : r(test::context(), scene, settings(maxDepth, seed)), dims(PathIntegrator::primaryDimsFor(maxDepth)), prng(prngSeed) {}
+  glm::vec2 fresh() { return glm::vec2(float(prng() >> 8), float(prng() >> 8)) * (1.0f / 16777216.0f); }
+  // Every draw of every slot fresh.
+  std::vector<glm::vec2> vectors() {
+    std::vector<glm::vec2> u(std::size_t(shared::primarySampleSlots(r.paths().capacity())) * dims);
+    for (glm::vec2& x : u) x = fresh();
+    return u;
+  }
+  std::size_t at(std::uint32_t slot, std::uint32_t dimension) const { return shared::primarySampleIndex(slot, dimension, dims); }
+  void trace(const std::vector<glm::vec2>& v, std::vector<glm::vec4>& L, std::vector<glm::uvec4>& info) {
+    PathIntegrator& paths = r.paths();
+    vk::uploadBuffer(test::context(), paths.primarySamples(), v.data(), v.size() * 8);
+    r.renderPass(1);
+    L.resize(slots);
+    info.resize(slots);
+    vk::downloadBuffer(test::context(), paths.pathRadiance(), L.data(), slots * 16);
+    vk::downloadBuffer(test::context(), paths.pathInfo(), info.data(), slots * 16);
+  }
+  Renderer r;
+  const std::uint32_t dims;
+  const std::uint32_t slots = 16 * 16;
+  std::mt19937 prng;
+};
+
 // A Metropolis small step moves only the draws its current path read and draws the others fresh
 // (mlt.h, mltExtent of the bounces the shade stage records in pathInfo.z). That is exact only if
 // the recorded extent covers every draw the path read: here every draw beyond it is replaced and
@@ -75,53 +114,32 @@ TEST(PrimaryRender, SameVectorSamePathOtherVectorOtherPath) {
 // by its light sample) must change most paths, so an extent one bounce short would fail.
 TEST(PrimaryRender, DrawsBeyondTheRecordedExtentAreNotRead) {
   Scene scene = loadSceneOrDefault("", "");
-  RenderSettings s;
-  s.width = 16;
-  s.height = 16;
-  s.spp = 1;
-  s.samplesPerPass = 1;
-  s.maxDepth = 5;
-  s.seed = 5;
-  s.primarySamples = true;
-  Renderer r(test::context(), scene, s);
-  PathIntegrator& paths = r.paths();
-  const std::uint32_t dims = PathIntegrator::primaryDimsFor(s.maxDepth);
-  const std::uint32_t slots = s.width * s.height;
-  std::mt19937 prng(17);
-  auto fresh = [&] { return glm::vec2(float(prng() >> 8), float(prng() >> 8)) * (1.0f / 16777216.0f); };
-  std::vector<glm::vec2> u(std::size_t(shared::primarySampleSlots(paths.capacity())) * dims);
-  for (glm::vec2& x : u) x = fresh();
-  auto trace = [&](const std::vector<glm::vec2>& v, std::vector<glm::vec4>& L, std::vector<glm::uvec4>& info) {
-    vk::uploadBuffer(test::context(), paths.primarySamples(), v.data(), v.size() * 8);
-    r.renderPass(1);
-    L.resize(slots);
-    info.resize(slots);
-    vk::downloadBuffer(test::context(), paths.pathRadiance(), L.data(), slots * 16);
-    vk::downloadBuffer(test::context(), paths.pathInfo(), info.data(), slots * 16);
-  };
+  Replay replay(scene, 5, 5, 17);
+  const std::uint32_t dims = replay.dims, slots = replay.slots;
+  std::vector<glm::vec2> u = replay.vectors();
   std::vector<glm::vec4> L0, L1, L2;
   std::vector<glm::uvec4> info0, info1, info2;
-  trace(u, L0, info0);
+  replay.trace(u, L0, info0);
 
   std::vector<glm::vec2> beyond = u, lastRead = u;
   int shortPaths = 0, lit = 0;
   for (std::uint32_t i = 0; i < slots; ++i) {
     const std::uint32_t extent = shared::mltExtent(info0[i].z, dims);
     shortPaths += extent < dims;
-    for (std::uint32_t d = extent; d < dims; ++d) beyond[shared::primarySampleIndex(i, d, dims)] = fresh();
+    for (std::uint32_t d = extent; d < dims; ++d) beyond[replay.at(i, d)] = replay.fresh();
     if (info0[i].z > 0) {
-      lastRead[shared::primarySampleIndex(i, shared::rngDimension(info0[i].z - 1, RNG_DIM_LIGHT_POINT), dims)] = fresh();
+      lastRead[replay.at(i, shared::rngDimension(info0[i].z - 1, RNG_DIM_LIGHT_POINT))] = replay.fresh();
       lit += L0[i] != glm::vec4(0.0f);
     }
   }
-  trace(beyond, L1, info1);
+  replay.trace(beyond, L1, info1);
   int changed = 0;
   for (std::uint32_t i = 0; i < slots; ++i) changed += std::memcmp(&L0[i], &L1[i], 12) != 0 || info0[i].z != info1[i].z;
   EXPECT_EQ(changed, 0) << "a draw beyond a path's recorded extent changed the path";
   // Not void: many paths end before the last bounce (roulette), so draws beyond them were replaced.
   EXPECT_GE(shortPaths, int(slots) / 4);
 
-  trace(lastRead, L2, info2);
+  replay.trace(lastRead, L2, info2);
   int changedLast = 0;
   for (std::uint32_t i = 0; i < slots; ++i) changedLast += std::memcmp(&L0[i], &L2[i], 12) != 0;
   // The last vertex's light sample moves with its point: most lit paths change (a point that stays
@@ -129,7 +147,7 @@ TEST(PrimaryRender, DrawsBeyondTheRecordedExtentAreNotRead) {
   EXPECT_GE(changedLast, lit / 2) << "the last shaded bounce's light-point draw seems unread";
   std::printf("%d of %u paths end before depth %u; replacing the draws beyond their extent changed %d; "
               "replacing the last bounce's light point changed %d of %d lit paths\n",
-              shortPaths, slots, s.maxDepth, changed, changedLast, lit);
+              shortPaths, slots, replay.r.settings().maxDepth, changed, changedLast, lit);
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
@@ -145,50 +163,29 @@ TEST(PrimaryRender, DrawsOutsideTheReadSlotsAreNotRead) {
                                  std::string("scenes/cornell/cornell-glossy.glb")}) {
     SCOPED_TRACE(file.empty() ? "default scene" : file);
     Scene scene = file.empty() ? loadSceneOrDefault("", "") : test::loadTestScene(file);
-    RenderSettings s;
-    s.width = 16;
-    s.height = 16;
-    s.spp = 1;
-    s.samplesPerPass = 1;
-    s.maxDepth = 6;
-    s.seed = 7;
-    s.primarySamples = true;
-    Renderer r(test::context(), scene, s);
-    PathIntegrator& paths = r.paths();
-    const std::uint32_t dims = PathIntegrator::primaryDimsFor(s.maxDepth);
-    const std::uint32_t slots = s.width * s.height;
-    std::mt19937 prng(23);
-    auto fresh = [&] { return glm::vec2(float(prng() >> 8), float(prng() >> 8)) * (1.0f / 16777216.0f); };
-    std::vector<glm::vec2> u(std::size_t(shared::primarySampleSlots(paths.capacity())) * dims);
-    for (glm::vec2& x : u) x = fresh();
-    auto trace = [&](const std::vector<glm::vec2>& v, std::vector<glm::vec4>& L, std::vector<glm::uvec4>& info) {
-      vk::uploadBuffer(test::context(), paths.primarySamples(), v.data(), v.size() * 8);
-      r.renderPass(1);
-      L.resize(slots);
-      info.resize(slots);
-      vk::downloadBuffer(test::context(), paths.pathRadiance(), L.data(), slots * 16);
-      vk::downloadBuffer(test::context(), paths.pathInfo(), info.data(), slots * 16);
-    };
+    Replay replay(scene, 6, 7, 23);
+    const std::uint32_t dims = replay.dims, slots = replay.slots;
+    std::vector<glm::vec2> u = replay.vectors();
     std::vector<glm::vec4> L0, L1, L2;
     std::vector<glm::uvec4> info0, info1, info2;
-    trace(u, L0, info0);
+    replay.trace(u, L0, info0);
     std::vector<glm::vec2> unread = u, bsdf = u;
     std::uint32_t replaced = 0, scattered = 0, deep = 0;
     for (std::uint32_t i = 0; i < slots; ++i) {
       for (std::uint32_t d = 0; d < dims; ++d)
         if (!shared::mltReadsDraw(d)) {
-          unread[shared::primarySampleIndex(i, d, dims)] = fresh();
+          unread[replay.at(i, d)] = replay.fresh();
           ++replaced;
         }
       scattered += info0[i].z > 0;
       deep += info0[i].z >= 3;  // past the bounces before the roulette starts
-      bsdf[shared::primarySampleIndex(i, shared::rngDimension(0, RNG_DIM_BSDF), dims)] = fresh();
+      bsdf[replay.at(i, shared::rngDimension(0, RNG_DIM_BSDF))] = replay.fresh();
     }
-    trace(unread, L1, info1);
+    replay.trace(unread, L1, info1);
     int changed = 0;
     for (std::uint32_t i = 0; i < slots; ++i) changed += std::memcmp(&L0[i], &L1[i], 12) != 0 || info0[i].z != info1[i].z;
     EXPECT_EQ(changed, 0) << "a draw outside the read slots changed the path";
-    trace(bsdf, L2, info2);
+    replay.trace(bsdf, L2, info2);
     int changedBsdf = 0;
     for (std::uint32_t i = 0; i < slots; ++i) changedBsdf += std::memcmp(&L0[i], &L2[i], 12) != 0 || info0[i].z != info2[i].z;
     EXPECT_GE(changedBsdf, int(scattered) / 2) << "the first bounce's BSDF draw seems unread";
