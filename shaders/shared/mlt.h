@@ -118,7 +118,8 @@ SHARED_FN bool mltReadsDraw(uint dimension) { return rngReadUnguided(dimension);
 SHARED_FN vec2 mltLargeStep(uvec4 h) { return vec2(mltUnit(h.z), mltUnit(h.w)); }
 
 // The proposal for draw u of a step with that draw's hash h: fresh (a large step, or a draw the
-// current path did not read: mltExtent) or moved by the small step.
+// current path did not read: mltExtent) or moved by the small step. (The mutation kernel stores
+// only the moved draws, mltSmallStep; the stages compute the fresh ones, mltFreshSample.)
 SHARED_FN vec2 mltPropose(vec2 u, uvec4 h, bool fresh, float sigma) {
   return fresh ? mltLargeStep(h) : mltSmallStep(u, h, sigma);
 }

@@ -16,8 +16,8 @@ using shared::Globals;
 
 std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t dims, std::uint32_t bootstrap,
                                       std::uint64_t pixels) {
-  // The second vector buffer, states, start indices, extents, stored draws; splat sums; the bootstrap's f values (and the chunk of
-  // b' for Kelemen's weights); GpuMlt, counters.
+  // The second vector buffer, states, start indices, extents, stored draws; splat sums; the
+  // bootstrap's f values (and the chunk of b' for Kelemen's weights); GpuMlt, counters.
   return std::uint64_t(shared::primarySampleSlots(chains)) * dims * 8ull + std::uint64_t(chains) * 32 + pixels * 24 +
          std::uint64_t(bootstrap) * 4 + 256;
 }
