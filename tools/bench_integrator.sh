@@ -20,8 +20,8 @@
 #   SCENES (default: the default Cornell box "default"), ARGS (extra options of the integrator's
 #   renders, e.g. "--mlt-chains 32768" or "--vegas-bins 16"), ARGS2, ARGS3 (when set: more variants
 #   of the integrator, named INTEGRATOR-2 and INTEGRATOR-3, interleaved with the others in every
-#   repeat and each compared with the path tracer, e.g. ARGS="--mlt-direct-spp 0"
-#   ARGS2="--mlt-direct-spp 1").
+#   repeat and each compared with the path tracer, e.g. ARGS="--mlt-pass-spp 0"
+#   ARGS2="--mlt-chain-light indirect").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 integrator=${1:?usage: tools/bench_integrator.sh mlt|vegas [DIR] [NUSSELT]}
@@ -69,8 +69,10 @@ for entry in $scenes; do
       sec=$(attr "$out" renderSeconds)
       spp=$(attr "$out" spp)
       rel=$("$bin" diff "$out" "$ref" | awk '{print $2}')
-      # Paths per spp: one per pixel, or one per chain for Metropolis.
-      perSpp=$(if [ "${mode%-[23]}" = mlt ]; then attr "$out" mltChains; else echo $((size * size)); fi)
+      # Paths per spp: one per pixel, or chains x steps for Metropolis (mutations; files without
+      # mltSteps moved each chain once per iteration).
+      steps=$(attr "$out" mltSteps)
+      perSpp=$(if [ "${mode%-[23]}" = mlt ]; then echo $(($(attr "$out" mltChains) * ${steps:-1})); else echo $((size * size)); fi)
       prod=$(calc "$rel * $sec")
       rate=$(calc "$spp * $perSpp / $sec / 1000000")
       perPath=$(calc "$rel * $spp")

@@ -42,6 +42,7 @@ cases=(
   "combined-uniform|scenes/tests/combined.gltf $small --components uniform"
   "combined-uniform-albedo|scenes/tests/combined.gltf $small --components uniform --roulette albedo"
   "cornell-mlt|$small --integrator mlt --mlt-chains 4096"
+  "cornell-mlt-indirect|$small --integrator mlt --mlt-chains 4096 --mlt-chain-light indirect --mlt-steps 2"
   "cornell-mlt-direct-in-chain|$small --integrator mlt --mlt-chains 4096 --mlt-direct-spp 0 --mlt-weights plain"
   "glass-mlt|scenes/cornell/cornell-glass.glb $small --integrator mlt --mlt-chains 2048"
   "cornell-vegas|$small --integrator vegas"

@@ -89,22 +89,30 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 // between the light and the camera: emission hit at shade bounce b or escaping after it has b, a
 // light sample (NEE) taken at bounce b has b + 1. Direct light has at most one (emission seen by
 // the camera ray, and NEE and MIS-weighted emitter hits from its first hit), indirect light the
-// rest. The parts use the full estimator's MIS weights, so direct + indirect = all, path by path
-// (Metropolis with direct light outside the chain: docs/mlt.md).
+// rest. Caustic light is what reached a non-delta vertex through one or more delta bounces straight
+// from the light (paths L S+ D ... E: an emitter hit or an escape after a delta bounce, with a
+// non-delta bounce before it), the light that next-event estimation cannot sample: the first such
+// contribution of a path (a caustic-only path ends there); non-caustic light is the rest (later
+// caustic contributions included). Each pair splits every contribution into exactly one part, and the parts use
+// the full estimator's MIS weights, so direct + indirect = caustic + non-caustic = all, path by
+// path (Metropolis with part of the light outside the chains: docs/mlt.md).
 #define RADIANCE_ALL 0u
 #define RADIANCE_DIRECT 1u
 #define RADIANCE_INDIRECT 2u
+#define RADIANCE_CAUSTIC 3u
+#define RADIANCE_NONCAUSTIC 4u
 // Globals.primaryFresh: a Metropolis pass (mlt.h) need not store every draw of a path's primary
 // sample vector; the draws it leaves out are hashes the stages compute where they read them
 // (mltFreshSample), the values the mlt kernels would have stored. NONE: every draw below
 // primaryDims is in primarySamples (VEGAS, the chains' starts). POOL: none is (a bootstrap path's
 // draws, mltPoolSample). MUTATE: slot c's proposal stores its first GpuMlt.written[c] draws, in
 // one of the chains' two vector buffers (MLT_SIDE_B of written[c]), the rest are the step's fresh
-// draws (mltLargeStep of mltHash). DIRECT: none is (a direct-light sample's, mltDirectDraw).
+// draws (mltLargeStep of mltHash). PIXEL: none is (a path-traced sample of the light outside the
+// chains: the path tracer's own numbers of its pixel and sample, mltPixelDraw).
 #define PRIMARY_FRESH_NONE 0u
 #define PRIMARY_FRESH_POOL 1u
 #define PRIMARY_FRESH_MUTATE 2u
-#define PRIMARY_FRESH_DIRECT 3u
+#define PRIMARY_FRESH_PIXEL 3u
 
 // ---- Material flags ---------------------------------------------------------------------------------
 #define MATERIAL_EMISSIVE 1u
@@ -398,10 +406,10 @@ struct GpuMlt {
   // Kelemen's weights: (1 when on, 1 / b' (b' from paths independent of the chains' starts),
   // 1 / b, large-step probability); x = 0: plain expected-value splats.
   vec4 weights;
-  // Direct light outside the chain (RenderSettings::mltDirectSpp > 0): (the number of the first
-  // direct sample of this trace, direct samples per pixel per iteration, direct samples per pixel
-  // in this trace, 0); y = 0: direct light in the chain.
-  uvec4 direct;
+  // Light outside the chains (RenderSettings::mltPassSpp > 0), path-traced per pixel: (the number
+  // of the first sample of this trace, samples per pixel per iteration, samples per pixel in this
+  // trace, 0); y = 0: all light in the chains.
+  uvec4 outside;
   BUFREF(Vec2s) vectorsB;
   BUFREF(Vec4s) state;
   BUFREF(Uints) splats;
@@ -473,7 +481,7 @@ struct Globals {
   BUFREF(Floats) lightCdf;     // lightCount + 1 entries, cdf[0] = 0, cdf[n] = 1
   BUFREF(Vec4s) film;          // per pixel: sum of samples (rgb), w = samples taken
   BUFREF(Vec4s) filmSq;        // per pixel: sum of squared samples (rgb)
-  BUFREF(Vec4s) pathOrigin;    // per path: ray origin
+  BUFREF(Vec4s) pathOrigin;    // per path: ray origin; w: caustic parts only (else 0): 1 once the path took a non-delta bounce, 2 once its caustic light counted
   BUFREF(Vec4s) pathDirection; // per path: ray direction, w = pdf of the BSDF sample (0: delta/camera)
   BUFREF(Vec4s) pathThroughput;// per path: throughput (rgb), w = etaScale (the product of (n_t / n_i)^2 over
                                // refractions, which undoes their radiance scaling for the roulette)
@@ -588,10 +596,12 @@ layout(set = 0, binding = 0, std430) readonly buffer GlobalsBlock { Globals g; }
 SHARED_FN uint primarySampleIndex(uint path, uint dimension, uint dims) {
   return ((path / PRIMARY_BLOCK) * dims + dimension) * PRIMARY_BLOCK + path % PRIMARY_BLOCK;
 }
-// Whether a contribution with `scatterings` vertices between light and camera belongs to `part`
-// (RADIANCE_*).
-SHARED_FN bool radiancePartKeeps(uint part, uint scatterings) {
-  return part == RADIANCE_ALL || ((part == RADIANCE_DIRECT) == (scatterings <= 1u));
+// Whether a contribution with `scatterings` vertices between light and camera, caustic or not,
+// belongs to `part` (RADIANCE_*).
+SHARED_FN bool radiancePartKeeps(uint part, uint scatterings, bool caustic) {
+  if (part == RADIANCE_ALL) return true;
+  if (part >= RADIANCE_CAUSTIC) return (part == RADIANCE_CAUSTIC) == caustic;
+  return (part == RADIANCE_DIRECT) == (scatterings <= 1u);
 }
 SHARED_FN uint primarySampleSlots(uint capacity) { return (capacity + PRIMARY_BLOCK - 1u) / PRIMARY_BLOCK * PRIMARY_BLOCK; }
 

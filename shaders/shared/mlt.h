@@ -26,13 +26,14 @@ SHARED_BEGIN
 #define MLT_KERNEL_MUTATE 3u   // path slot c gets chain c's proposal (the draws it moves; the rest fresh)
 #define MLT_KERNEL_ACCEPT 4u   // splat current and proposal, accept or reject
 #define MLT_KERNEL_RESOLVE 5u  // the pass's splats into the film
-// Direct light outside the chain: pixels pool.x .. pool.x + pool.y - 1, direct.z samples each
-// (numbers direct.x + k): path slot k x pool.y + c traces sample k of pixel pool.x + c (a camera
-// draw uniform in that pixel, the rest hashed: PRIMARY_FRESH_DIRECT, no kernel before the trace)
-// for direct light only; then invocation c adds its pixel's samples / direct.y to the film, in
-// sample order (no atomics).
-#define MLT_KERNEL_DIRECT_ADD 6u
-#define MLT_KERNELS 7u
+// Light outside the chains (the part the chains do not carry, path-traced per pixel): pixels
+// pool.x .. pool.x + pool.y - 1, outside.z samples each (numbers outside.x + k): path slot
+// k x pool.y + c traces sample k of pixel pool.x + c with the path tracer's numbers
+// (PRIMARY_FRESH_PIXEL, mltPixelDraw; no kernel before the trace); then invocation c adds its
+// pixel's samples / outside.y to the film, in sample order (no atomics).
+#define MLT_KERNEL_PIXEL_ADD 6u
+#define MLT_KERNEL_ADVANCE 7u  // one invocation: the next step of the iteration (info.z + 1)
+#define MLT_KERNELS 8u
 // No kernel (MltIntegrator::traceBetween).
 #define MLT_KERNEL_NONE 0xffffffffu
 // Splats are sums of fixed-point integers (2^24 units per unit of luminance-normalised radiance),
@@ -51,7 +52,6 @@ SHARED_BEGIN
 #define MLT_STREAM_MUTATE 0x6d75u
 #define MLT_STREAM_POOL 0x706fu
 #define MLT_STREAM_START 0x7374u
-#define MLT_STREAM_DIRECT 0x6469u
 
 // The chains' state: GpuMlt (layout.h, Globals.mlt).
 
@@ -68,16 +68,11 @@ SHARED_FN vec2 mltPoolSample(uint i, uint dimension, uint seed) {
   return vec2(mltUnit(h.x), mltUnit(h.y));
 }
 
-// Direct sample `number` of a pixel, draw `dimension`: independent uniforms (24 bits, never 1).
-SHARED_FN vec2 mltDirectSample(uint pixel, uint number, uint dimension, uint seed) {
-  uvec4 h = pcg4d(uvec4(pixel, number, dimension, seed ^ (MLT_STREAM_DIRECT << 16u)));
-  return vec2(mltUnit(h.x), mltUnit(h.y));
-}
-
-// Draw `dimension` of direct sample `number` of a pixel of an image of `size`: draw 0 places the
-// ray on the image (camera.comp, IMAGE_SAMPLES) uniformly within the pixel.
-SHARED_FN vec2 mltDirectDraw(uint pixel, uint number, uint dimension, uint seed, uvec2 size) {
-  vec2 u = mltDirectSample(pixel, number, dimension, seed);
+// Draw `dimension` of sample `number` of a pixel of an image of `size` in a path-traced pass:
+// the path tracer's draw (rng.h, sample2 of the render's mode: QMC by default), except that draw 0,
+// the jitter in the pixel, places the ray on the image (camera.comp, IMAGE_SAMPLES) within it.
+SHARED_FN vec2 mltPixelDraw(uint mode, uint pixel, uint number, uint dimension, uint seed, uvec2 size) {
+  vec2 u = sample2(mode, pixel, number, dimension, seed);
   if (dimension == 0u) u = (vec2(float(pixel % size.x), float(pixel / size.x)) + u) / vec2(float(size.x), float(size.y));
   return u;
 }
@@ -128,7 +123,7 @@ SHARED_FN vec2 mltPropose(vec2 u, uvec4 h, bool fresh, float sigma) {
 // the stages compute it where they read it and the mlt kernels where they keep it: POOL, draw
 // `dimension` of bootstrap path key.x with the bootstrap's seed key.y (mltPoolSample); MUTATE, the
 // step's fresh draw of chain `slot` at iteration key.x with the render's seed key.y (mltLargeStep).
-// (DIRECT: mltDirectDraw, which needs the image's size.)
+// (PIXEL: mltPixelDraw, which needs the image's size.)
 SHARED_FN vec2 mltFreshSample(uint mode, uint slot, uint dimension, uvec2 key) {
   if (mode == PRIMARY_FRESH_POOL) return mltPoolSample(key.x, dimension, key.y);
   return mltLargeStep(mltHash(slot, key.x, dimension, key.y));

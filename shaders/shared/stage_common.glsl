@@ -74,9 +74,9 @@ PathKey makePathKey(uint pixel, uint sampleIndex, uint path) {
     if (g.primaryFresh == PRIMARY_FRESH_POOL) {
       uvec4 pool = mlt.v[0].pool;
       k.freshKey = uvec2(pool.x + path, pool.w);
-    } else if (g.primaryFresh == PRIMARY_FRESH_DIRECT) {
+    } else if (g.primaryFresh == PRIMARY_FRESH_PIXEL) {
       uvec4 pool = mlt.v[0].pool;
-      k.freshKey = uvec2(pool.x + path % pool.y, mlt.v[0].direct.x + path / pool.y);
+      k.freshKey = uvec2(pool.x + path % pool.y, mlt.v[0].outside.x + path / pool.y);
     } else {
       uint w = mlt.v[0].written.v[path];
       k.written = w & MLT_COUNT;
@@ -95,8 +95,8 @@ PathKey pathKey(uint path) {
 vec2 pathSample2(PathKey k, uint dimension) {
   if (PRIMARY_SAMPLES && dimension < g.primaryDims) {
     if (dimension >= k.written) {
-      if (g.primaryFresh == PRIMARY_FRESH_DIRECT)
-        return mltDirectDraw(k.freshKey.x, k.freshKey.y, dimension, g.seed, uvec2(g.width, g.height));
+      if (g.primaryFresh == PRIMARY_FRESH_PIXEL)
+        return mltPixelDraw(k.rngMode, k.freshKey.x, k.freshKey.y, dimension, k.seed, uvec2(g.width, g.height));
       return mltFreshSample(g.primaryFresh, k.path, dimension, k.freshKey);
     }
     return k.vectors.v[primarySampleIndex(k.path, dimension, g.primaryDims)];

@@ -30,7 +30,10 @@ void main() {
       w = powerHeuristic(prevPdf, lightPdf);
     }
   }
-  if (w > 0.0f && radiancePartKeeps(g.radiancePart, pc.bounce)) {
+  // Caustic light (layout.h, RADIANCE_CAUSTIC): after a delta bounce (pdf 0) that followed a
+  // non-delta one, its path's first (pathOrigin.w = 1: shade_body.glsl).
+  bool caustic = g.radiancePart >= RADIANCE_CAUSTIC && pc.bounce > 0u && prevPdf == 0.0f && g.pathOrigin.v[path].w == 1.0f;
+  if (w > 0.0f && radiancePartKeeps(g.radiancePart, pc.bounce, caustic)) {
     vec3 beta = loadVec4(g.pathThroughput, path).xyz;
     vec4 R = loadVec4(g.pathRadiance, path);
     storeVec4(g.pathRadiance, path, vec4(R.xyz + beta * envRadiance(E, dir) * w, R.w));

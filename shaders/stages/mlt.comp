@@ -114,11 +114,16 @@ void main() {
     count(m, 1u, accepted);
     count(m, 2u, live && large);
     count(m, 3u, accepted && large);
-  } else if (MLT_KERNEL == MLT_KERNEL_DIRECT_ADD) {
+  } else if (MLT_KERNEL == MLT_KERNEL_PIXEL_ADD) {
     if (c >= m.pool.y) return;
     vec3 sum = vec3(0.0f);
-    for (uint k = 0u; k < m.direct.z; ++k) sum += tracedRadiance(k * m.pool.y + c);
-    g.film.v[m.pool.x + c].xyz += sum / float(m.direct.y);
+    for (uint k = 0u; k < m.outside.z; ++k) sum += tracedRadiance(k * m.pool.y + c);
+    g.film.v[m.pool.x + c].xyz += sum / float(m.outside.y);
+  } else if (MLT_KERNEL == MLT_KERNEL_ADVANCE) {
+    if (c == 0u) {
+      Mlts state = g.mlt;
+      state.v[0].info.z = iteration + 1u;
+    }
   } else if (MLT_KERNEL == MLT_KERNEL_RESOLVE) {
     if (c >= m.info.w) return;
     vec3 sum;

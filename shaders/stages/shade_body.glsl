@@ -597,7 +597,7 @@ void nextEvent(ShadeMaterial m, uint path, PathKey k, uint bounce, uint lighting
 // roulette (the default; the albedo roulette decided in shadeSample): survivors are divided by
 // the probability.
 void continuePath(PathStep s, uint path, uint bounce, uint roulette, vec3 x, vec3 xo, vec3 ng, vec3 tt, vec3 bb,
-                  vec3 ns, vec3 beta, float etaScale, float uR) {
+                  vec3 ns, vec3 beta, float etaScale, float uR, float causticState) {
   vec3 wi = toWorld(s.wiLocal, tt, bb, ns);
   bool transmitted = s.wiLocal.z < 0.0f;
   if (transmitted != (dot(wi, ng) < 0.0f)) return;
@@ -609,7 +609,7 @@ void continuePath(PathStep s, uint path, uint bounce, uint roulette, vec3 x, vec
   }
   if (GUIDING && !guidePhotons())
     guideRecordSample(path, bounce, wi, s.delta ? -1.0f : luminance(beta) * s.pdf, s.selection);
-  storeVec4(g.pathOrigin, path, vec4(xo, 0.0f));
+  storeVec4(g.pathOrigin, path, vec4(xo, causticState));
   storeVec4(g.pathDirection, path, vec4(wi, s.pdf));
   storeVec4(g.pathThroughput, path, vec4(beta, etaScale));
   queuePush(((bounce + 1u) & 1u), path);
@@ -669,8 +669,17 @@ void main() {
     if (power > 0.0f && isFinite(power)) guideRecordPhoton(path, bounce, x, -dir, power);
   }
 
+  // Caustic light (RADIANCE_CAUSTIC, NONCAUSTIC; layout.h): the path's state in pathOrigin.w (0: no
+  // non-delta bounce yet, 1: one, 2: its caustic light counted), and whether it arrived here by a
+  // delta bounce (pdf 0).
+  uint part = g.radiancePart;
+  float causticState = part >= RADIANCE_CAUSTIC ? g.pathOrigin.v[path].w : 0.0f;
+  bool caustic = causticState == 1.0f && bounce > 0u && prevPdf == 0.0f;
+  bool emits = (M.info.y & MATERIAL_EMISSIVE) != 0u && frontFace && !photon;
+  if (caustic && emits) causticState = 2.0f;
+
   // ---- Emission: one-sided emitters radiate along their geometric normal ----
-  if ((M.info.y & MATERIAL_EMISSIVE) != 0u && frontFace && !photon) {
+  if (emits) {
     float w = 1.0f;
     if (bounce > 0u && prevPdf > 0.0f) {  // reached by a BSDF sample that light sampling could also make
       if (lighting == LIGHTING_NEE_ONLY) {
@@ -680,7 +689,7 @@ void main() {
         w = powerHeuristic(prevPdf, lightPdf);
       }
     }
-    if (radiancePartKeeps(g.radiancePart, bounce)) L += beta * Le * w;
+    if (radiancePartKeeps(part, bounce, caustic)) L += beta * Le * w;
   }
 
   // ---- Local frame: surfaces are two-sided, shade the side the ray came from ----
@@ -698,12 +707,12 @@ void main() {
   }
   vec3 xo = offsetRay(x, ng);
   // Direct light only (RADIANCE_DIRECT): nothing after the second vertex counts, so the path ends
-  // there.
-  uint part = g.radiancePart;
-  bool last = bounce >= g.maxDepth || (part == RADIANCE_DIRECT && bounce >= 1u);
+  // there; caustic light only, nothing after its caustic light.
+  bool last = bounce >= g.maxDepth || (part == RADIANCE_DIRECT && bounce >= 1u) ||
+              (part == RADIANCE_CAUSTIC && causticState == 2.0f);
 
   ShadeMaterial m = shadeMaterial(M, x, wo, roulette, ShadeHit(S.info.x, tri, hit.y, hit.z), !frontFace);
-  if (!last && !photon && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m) && radiancePartKeeps(part, bounce + 1u))
+  if (!last && !photon && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m) && radiancePartKeeps(part, bounce + 1u, false))
     nextEvent(m, path, key, bounce, lighting, x, xo, ng, tt, bb, ns, wo, beta);
 
   if (L != vec3(0.0f)) {
@@ -716,5 +725,6 @@ void main() {
   float uR = pathSample1(key, rngDimension(bounce, RNG_DIM_ROULETTE));
   PathStep s;
   if (!shadeSample(m, key, bounce, roulette, wo, !frontFace, tt, bb, ns, uR, s)) return;
-  continuePath(s, path, bounce, roulette, x, xo, ng, tt, bb, ns, beta, etaScale, uR);
+  if (causticState == 0.0f && !s.delta && part >= RADIANCE_CAUSTIC) causticState = 1.0f;
+  continuePath(s, path, bounce, roulette, x, xo, ng, tt, bb, ns, beta, etaScale, uR, causticState);
 }

@@ -58,12 +58,14 @@ struct RenderArgs {
   std::string roulette = "throughput";
   std::string traversal = "auto";
   std::string integrator = "path";
-  std::uint32_t mltChains = 65536;
+  std::uint32_t mltChains = RenderSettings{}.mltChains;
   std::uint32_t mltBootstrap = 0;
-  float mltLargeStep = 0.3f;
-  float mltSigma = 0.01f;
+  float mltLargeStep = RenderSettings{}.mltLargeStep;
+  float mltSigma = RenderSettings{}.mltSigma;
   std::string mltWeights = "kelemen";
-  std::uint32_t mltDirectSpp = RenderSettings{}.mltDirectSpp;
+  std::uint32_t mltPassSpp = RenderSettings{}.mltPassSpp;
+  std::string mltChainLight = "caustic";
+  std::uint32_t mltSteps = RenderSettings{}.mltSteps;
   std::uint32_t vegasBins = 64;
   std::uint32_t vegasBounces = 1;
   float vegasAlpha = 0.2f;
@@ -129,7 +131,9 @@ int renderCommand(const RenderArgs& a) {
   s.mltLargeStep = a.mltLargeStep;
   s.mltSigma = a.mltSigma;
   s.mltKelemen = a.mltWeights == "kelemen";
-  s.mltDirectSpp = a.mltDirectSpp;
+  s.mltPassSpp = a.mltPassSpp;
+  s.mltSteps = a.mltSteps;
+  s.mltChainLight = a.mltChainLight == "indirect" ? RADIANCE_INDIRECT : RADIANCE_CAUSTIC;
   s.vegasBins = a.vegasBins;
   s.vegasBounces = a.vegasBounces;
   s.vegasAlpha = a.vegasAlpha;
@@ -332,7 +336,10 @@ int renderCommand(const RenderArgs& a) {
       std::fprintf(stderr, "guiding: %u training spp%s, %.3f s of CPU time reading records, splatting and refining\n",
                    trained, why.c_str(), guide->trainingSeconds());
     }
-    if (const MltIntegrator* mlt = renderer.mlt(); mlt && !a.quiet) {
+    if (const MltIntegrator* mlt = renderer.mlt(); mlt && !a.quiet && mlt->report().noCaustics) {
+      std::fprintf(stderr, "mlt: no material has a delta lobe, so no path carries caustic light: the chains stayed idle "
+                           "and the path-traced pass rendered all light (--mlt-chain-light, docs/mlt.md)\n");
+    } else if (const MltIntegrator* mlt = renderer.mlt(); mlt && !a.quiet) {
       const MltReport& m = mlt->report();
       std::fprintf(stderr, "mlt: %u chains of %u primary draws; bootstrap %u paths (%llu with f > 0), b = %.6g, in %.2f s; "
                            "%s; %llu mutations, acceptance %.1f %% (large steps %.1f %% of them, accepted %.1f %%)\n",
@@ -856,7 +863,7 @@ int runCli(int argc, char** argv) {
   render->add_option("--mlt-chains", ra.mltChains, "mlt: Markov chains in flight (each a path per mutation)")
       ->capture_default_str()->check(CLI::Range(64u, 4194240u));
   render->add_option("--mlt-bootstrap", ra.mltBootstrap, "mlt: independent bootstrap paths for the normalisation and "
-                                                         "the chains' starts (0: 16 x chains)")
+                                                         "the chains' starts (0: 16 x chains, at least 2^20)")
       ->capture_default_str();
   render->add_option("--mlt-large-step", ra.mltLargeStep, "mlt: probability of a large step (an independent path)")
       ->capture_default_str()->check(CLI::Range(0.0f, 1.0f));
@@ -866,10 +873,17 @@ int runCli(int argc, char** argv) {
                                                      "independent path samples, combined with the chain) or plain "
                                                      "(expected-value splats only; docs/mlt.md)")
       ->capture_default_str()->check(CLI::IsMember({"kelemen", "plain"}));
-  render->add_option("--mlt-direct-spp", ra.mltDirectSpp, "mlt: direct light outside the chains: path-traced "
-                                                          "direct-light samples per pixel per mutation (the chains "
-                                                          "then carry indirect light only); 0: the chains carry all "
-                                                          "light (docs/mlt.md)")
+  render->add_option("--mlt-chain-light", ra.mltChainLight,
+                     "mlt: the light the chains carry: caustic (light that reached a diffuse or glossy surface "
+                     "through mirrors or glass from the light, which next-event estimation cannot sample) or "
+                     "indirect (two or more scatterings); a per-pixel path-traced pass adds the rest (docs/mlt.md)")
+      ->capture_default_str()->check(CLI::IsMember({"caustic", "indirect"}));
+  render->add_option("--mlt-steps", ra.mltSteps, "mlt: steps of every chain per iteration (one sample per pixel of "
+                                                 "the render's count, with --mlt-pass-spp path-traced samples)")
+      ->capture_default_str()->check(CLI::Range(1u, 1024u));
+  render->add_option("--mlt-pass-spp,--mlt-direct-spp", ra.mltPassSpp,
+                     "mlt: path-traced samples per pixel per mutation of the light the chains do not carry "
+                     "(--mlt-chain-light); 0: the chains carry all light (docs/mlt.md)")
       ->capture_default_str()->check(CLI::Range(0u, 64u));
   render->add_option("--vegas-bins", ra.vegasBins, "vegas: bins of each warped axis's density (1 .. 4096)")
       ->capture_default_str();

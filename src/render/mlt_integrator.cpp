@@ -14,25 +14,30 @@ namespace nusselt {
 using shared::GpuMlt;
 using shared::Globals;
 
-std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t dims, std::uint32_t bootstrap,
-                                      std::uint64_t pixels) {
+std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t slots, std::uint32_t dims,
+                                      std::uint32_t bootstrap, std::uint64_t pixels) {
   // The second vector buffer, states, start indices, extents, stored draws; splat sums; the
   // bootstrap's f values (and the chunk of b' for Kelemen's weights); GpuMlt, counters.
   return std::uint64_t(shared::primarySampleSlots(chains)) * dims * 8ull + std::uint64_t(chains) * 32 + pixels * 24 +
-         std::uint64_t(bootstrap) * 4 + 256;
+         (std::uint64_t(bootstrap) + slots) * 4 + 256;
+}
+
+std::uint32_t MltIntegrator::pathSlotsFor(const RenderSettings& s, std::uint64_t pixels) {
+  if (!s.mltPassSpp) return s.mltChains;
+  return static_cast<std::uint32_t>(std::max<std::uint64_t>(s.mltChains, std::min<std::uint64_t>(pixels * s.mltPassSpp, 1u << 16)));
 }
 
 std::uint32_t MltIntegrator::iterationsPerPassFor(const RenderSettings& s) {
   if (s.samplesPerPass) return s.samplesPerPass;
-  return std::max<std::uint32_t>(1, (1u << 18) / std::max<std::uint32_t>(s.mltChains, 1));
+  return std::max<std::uint32_t>(1, (1u << 18) / std::max<std::uint32_t>(s.mltChains * std::max(s.mltSteps, 1u), 1));
 }
 
 MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
-                             std::unique_ptr<PathIntegrator> paths, std::uint64_t pixels)
-    : PrimarySampleIntegrator(ctx, globals, settings, std::move(paths), pixels) {
-  m_chains = m_paths->capacity();
+                             std::unique_ptr<PathIntegrator> paths, std::uint64_t pixels, MltScene scene)
+    : PrimarySampleIntegrator(ctx, globals, settings, std::move(paths), pixels), m_scene(scene) {
+  m_chains = settings.mltChains;
   m_dims = globals.host().primaryDims;
-  if (m_dims == 0 || m_chains == 0) throw Error("mlt: the path tracer has no primary samples");
+  if (m_dims == 0 || m_chains == 0 || m_paths->capacity() < m_chains) throw Error("mlt: the path tracer has no primary samples");
   m_poolSize = mltBootstrapPaths(settings);
   m_report.chains = m_chains;
   m_report.dims = m_dims;
@@ -43,7 +48,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   vk::Buffer* vectorsB = make(std::uint64_t(shared::primarySampleSlots(m_chains)) * m_dims * 8, "mlt vectors");
   vk::Buffer* state = make(std::uint64_t(m_chains) * 16, "mlt chain states");
   m_splats = make(m_pixels * 24, "mlt splats");
-  m_poolF = make((std::uint64_t(m_poolSize) + m_chains) * 4, "mlt bootstrap");
+  m_poolF = make((std::uint64_t(m_poolSize) + m_paths->capacity()) * 4, "mlt bootstrap");
   m_start = make(std::uint64_t(m_chains) * 4, "mlt chain starts");
   vk::Buffer* extent = make(std::uint64_t(m_chains) * 4, "mlt chain extents");
   vk::Buffer* written = make(std::uint64_t(m_chains) * 4, "mlt stored draws");
@@ -62,7 +67,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m.counters = m_counters->address;
   m.extent = extent->address;
   m.written = written->address;
-  m.direct = {0u, settings.mltDirectSpp, 0u, 0u};
+  m.outside = {0u, settings.mltPassSpp, 0u, 0u};
   globals.host().mlt = m_mlt->address;
 
   VkCommandBuffer cmd = vk::beginOneShot(m_ctx);
@@ -75,6 +80,13 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
 MltIntegrator::~MltIntegrator() = default;
 
 void MltIntegrator::bootstrap(std::uint32_t firstSample) {
+  m_bootstrapped = true;
+  // Without a delta lobe in the scene no path has caustic light: the chains' part is 0, known
+  // without a pool (b = 0, the chains idle), and the path-traced pass carries all light.
+  if (chainPart() == RADIANCE_CAUSTIC && !m_scene.deltaMaterials) {
+    m_report.noCaustics = true;
+    return;
+  }
   auto t0 = std::chrono::steady_clock::now();
   Globals& g = m_globals.host();
   GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
@@ -87,9 +99,10 @@ void MltIntegrator::bootstrap(std::uint32_t firstSample) {
   g.chunkFirst = 0;
   g.passSamples = 1;
   g.sampleIndex = 0;
-  // The pool, a chunk of at most `chains` paths at a time.
-  for (std::uint32_t first = 0; first < m_poolSize; first += m_chains) {
-    const std::uint32_t count = std::min(m_chains, m_poolSize - first);
+  // The pool, a chunk of at most the path slots at a time.
+  const std::uint32_t slots = m_paths->capacity();
+  for (std::uint32_t first = 0; first < m_poolSize; first += slots) {
+    const std::uint32_t count = std::min(slots, m_poolSize - first);
     m.pool.x = first;
     m.pool.y = count;
     g.chunkPaths = count;
@@ -109,13 +122,17 @@ void MltIntegrator::bootstrap(std::uint32_t firstSample) {
   const double total = cdf[m_poolSize];
   m_report.b = total / double(m_poolSize);
   if (total > 0) {
-    // Chain c starts at the pool path whose cdf interval holds a uniform number of 48 bits from a
-    // hash of (c, seed): the start is drawn in proportion to f_i, independently per chain.
+    // Stratified resampling: chain c starts at the pool path whose cdf interval holds (c + u) /
+    // chains of the total, u uniform (48 bits from a hash of (c, seed)). Chain c's start is drawn
+    // from its own stratum of the cdf; over the chains, whose mean is the image, the starts are
+    // in proportion to f_i, so E[b x mean over chains of h(X_0)] = E[(1/B) sum_i f_i h(x_i)] still,
+    // and each pool path starts within one chain of its expected count (independent draws
+    // scattered the counts multinomially).
     std::vector<std::uint32_t> start(m_chains);
     for (std::uint32_t c = 0; c < m_chains; ++c) {
       const glm::uvec4 h = shared::pcg4d(glm::uvec4(c, seed, MLT_STREAM_START, 0x9e3779b9u));
       const double u = (double(h.x >> 8) * 16777216.0 + double(h.y >> 8)) / 281474976710656.0;
-      const double target = u * total;
+      const double target = (double(c) + u) / double(m_chains) * total;
       auto it = std::upper_bound(cdf.begin() + 1, cdf.end(), target);
       std::uint32_t i = static_cast<std::uint32_t>(std::min<std::ptrdiff_t>(it - cdf.begin() - 1, m_poolSize - 1));
       while (i > 0 && f[i] <= 0.0f) --i;  // a zero-width interval is never chosen (u < 1 guards the end)
@@ -129,31 +146,31 @@ void MltIntegrator::bootstrap(std::uint32_t firstSample) {
   }
   // Kelemen's weights need b', an estimate of b independent of the chains' starts (the weights are
   // then a fixed function on the chain's space and the estimate stays unbiased; b itself from the
-  // same pool as the starts keeps E[b h(X_0)] = the integral of f h): one more chunk of `chains`
-  // independent paths, pool indices poolSize .. poolSize + chains - 1.
+  // same pool as the starts keeps E[b h(X_0)] = the integral of f h): one more chunk of independent
+  // paths, as many as the path slots, pool indices poolSize .. poolSize + slots - 1.
   m.weights = {0.0f, 0.0f, 0.0f, 0.0f};
   if (m_settings.mltKelemen && m_settings.mltLargeStep > 0.0f && m_report.b > 0) {
     m.pool.x = m_poolSize;
-    m.pool.y = m_chains;
-    g.chunkPaths = m_chains;
+    m.pool.y = slots;
+    g.chunkPaths = slots;
     g.primaryFresh = PRIMARY_FRESH_POOL;
     m_globals.upload();
-    traceBetween(MLT_KERNEL_NONE, MLT_KERNEL_RECORD, m_chains);
-    std::vector<float> fb(m_chains);
-    vk::downloadBuffer(m_ctx, *m_poolF, fb.data(), std::uint64_t(m_chains) * 4, std::uint64_t(m_poolSize) * 4);
+    traceBetween(MLT_KERNEL_NONE, MLT_KERNEL_RECORD, slots);
+    std::vector<float> fb(slots);
+    vk::downloadBuffer(m_ctx, *m_poolF, fb.data(), std::uint64_t(slots) * 4, std::uint64_t(m_poolSize) * 4);
     double sum = 0;
     for (float v : fb) sum += std::max(0.0, double(v));
-    m_report.bPrime = sum / double(m_chains);
+    m_report.bPrime = sum / double(slots);
     // Without light in that chunk there is no b' to weigh by: the plain splats (a choice made from
     // the chunk alone, so the estimate stays unbiased).
     if (m_report.bPrime > 0)
       m.weights = {1.0f, static_cast<float>(1.0 / m_report.bPrime), static_cast<float>(1.0 / m_report.b),
                    m_settings.mltLargeStep};
   }
-  // Film value of a splat sum: b x pixels / chains per unit, per iteration (the film divides by
-  // its count, the iterations).
-  m.params.z = static_cast<float>(m_report.b * double(m_pixels) / double(m_chains) / double(MLT_FIXED_SCALE));
-  m_bootstrapped = true;
+  // Film value of a splat sum: b x pixels / (chains x steps) per unit, per iteration (the film
+  // divides by its count, the iterations).
+  m.params.z = static_cast<float>(m_report.b * double(m_pixels) / (double(m_chains) * m_settings.mltSteps) /
+                                  double(MLT_FIXED_SCALE));
   m_report.bootstrapSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
@@ -185,11 +202,25 @@ void MltIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples)
   g.chunkPaths = m_chains;
   g.passSamples = 1;
   if (m_report.b > 0) {
+    // Every iteration moves each chain settings.mltSteps times, in one submission; step j of
+    // iteration i is step i x mltSteps + j of the render (GpuMlt.info.z, which keys the step's
+    // random numbers: MLT_KERNEL_ADVANCE counts it on the device between steps). The camera's
+    // sample index is the iteration's first step: a chain's path reads only its vector.
+    const std::uint32_t steps = m_settings.mltSteps;
     for (std::uint32_t k = 0; k < samples; ++k) {
-      g.sampleIndex = sampleIndex + k;
-      m.info.z = sampleIndex + k;  // keys the step's random numbers
+      const std::uint32_t first = (sampleIndex + k) * steps;
+      g.sampleIndex = first;
+      m.info.z = first;
       m_globals.upload();
-      traceBetween(MLT_KERNEL_MUTATE, MLT_KERNEL_ACCEPT, m_chains);
+      VkCommandBuffer cmd = begin();
+      for (std::uint32_t j = 0; j < steps; ++j) {
+        if (j > 0) dispatch(cmd, MLT_KERNEL_ADVANCE, 1);
+        dispatch(cmd, MLT_KERNEL_MUTATE, m_chains);
+        m_paths->recordTrace(cmd, m_chains);
+        vk::computeBarrier(cmd);
+        dispatch(cmd, MLT_KERNEL_ACCEPT, m_chains);
+      }
+      submit();
       readCounters();
     }
   }
@@ -198,38 +229,39 @@ void MltIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples)
   VkCommandBuffer cmd = begin();
   dispatch(cmd, MLT_KERNEL_RESOLVE, static_cast<std::uint32_t>(m_pixels));
   submit();
-  if (m_settings.mltDirectSpp) directPass(sampleIndex, samples);
+  if (m_settings.mltPassSpp) outsidePass(sampleIndex, samples);
 }
 
 std::uint32_t MltIntegrator::chainPart() const {
-  return m_settings.mltDirectSpp ? RADIANCE_INDIRECT : RADIANCE_ALL;
+  return m_settings.mltPassSpp ? m_settings.mltChainLight : RADIANCE_ALL;
 }
 
-void MltIntegrator::directPass(std::uint32_t sampleIndex, std::uint32_t samples) {
+void MltIntegrator::outsidePass(std::uint32_t sampleIndex, std::uint32_t samples) {
   Globals& g = m_globals.host();
   GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
-  const std::uint32_t perIteration = m_settings.mltDirectSpp;
+  const std::uint32_t perIteration = m_settings.mltPassSpp;
   const std::uint32_t total = samples * perIteration;
   // Pixels per trace (at most the path slots), and as many samples of each as the slots hold.
-  const std::uint32_t pixelsPerTrace = static_cast<std::uint32_t>(std::min<std::uint64_t>(m_chains, m_pixels));
-  g.radiancePart = RADIANCE_DIRECT;
-  g.primaryFresh = PRIMARY_FRESH_DIRECT;  // a direct sample's draws are hashes of its pixel and number
+  const std::uint32_t slots = m_paths->capacity();
+  const std::uint32_t pixelsPerTrace = static_cast<std::uint32_t>(std::min<std::uint64_t>(slots, m_pixels));
+  g.radiancePart = m_settings.mltChainLight == RADIANCE_INDIRECT ? RADIANCE_DIRECT : RADIANCE_NONCAUSTIC;
+  g.primaryFresh = PRIMARY_FRESH_PIXEL;  // the path tracer's numbers of the pixel and sample
   g.chunkFirst = 0;
   g.passSamples = 1;
   for (std::uint32_t k = 0; k < total;) {
-    // Direct samples are numbered by iteration, so a resumed render's continue the first segment's.
+    // Samples are numbered by iteration, so a resumed render's continue the first segment's.
     const std::uint32_t number = sampleIndex * perIteration + k;
-    const std::uint32_t per = std::max<std::uint32_t>(1, std::min<std::uint32_t>(total - k, m_chains / pixelsPerTrace));
+    const std::uint32_t per = std::max<std::uint32_t>(1, std::min<std::uint32_t>(total - k, slots / pixelsPerTrace));
     g.sampleIndex = number;
-    m.direct.x = number;
-    m.direct.z = per;
+    m.outside.x = number;
+    m.outside.z = per;
     for (std::uint64_t first = 0; first < m_pixels; first += pixelsPerTrace) {
       const std::uint32_t count = static_cast<std::uint32_t>(std::min<std::uint64_t>(pixelsPerTrace, m_pixels - first));
       m.pool.x = static_cast<std::uint32_t>(first);
       m.pool.y = count;
       g.chunkPaths = count * per;
       m_globals.upload();
-      traceBetween(MLT_KERNEL_NONE, MLT_KERNEL_DIRECT_ADD, count * per);
+      traceBetween(MLT_KERNEL_NONE, MLT_KERNEL_PIXEL_ADD, count * per);
     }
     k += per;
   }

@@ -6,9 +6,10 @@
 //
 //   bootstrap (once): B independent paths (vectors hashed from their index), f_i = luminance(L_i)
 //     (L: the chains' part of the radiance, below);
-//     b = mean f_i (the normalisation: the integral of f over primary sample space); each chain
-//     starts at pool path i chosen with probability f_i / sum f (on the host, from a hash of the
-//     chain index and the seed), re-traced from its vector (a path is a function of it).
+//     b = mean f_i (the normalisation: the integral of f over primary sample space); the chains
+//     start at pool paths drawn in proportion to f_i by stratified resampling (chain c from the
+//     stratum [c, c + 1) / chains of the cdf, on the host, from a hash of the chain index and the
+//     seed), each re-traced from its vector (a path is a function of it).
 //   step (per iteration, all chains at once): propose (large step with probability p, else small
 //     step), trace, splat the proposal with weight a and the current state with 1 - a (a =
 //     min(1, f(y) / f(x))), each as L / f, into 64-bit fixed-point sums; accept with probability a.
@@ -16,18 +17,22 @@
 //     large step's path counts once more as an independent sample (docs/mlt.md).
 //   resolve (per pass): film += (b x pixels / chains) x splats, count += iterations.
 //
-// The estimate is unbiased for any chain length: the start is drawn from the pool in proportion
-// to f with b from the same pool, so E[b h(X_0)] = E[(1/B) sum_i f_i h(x_i)] = integral of f h,
-// and each step preserves it (f-invariance of the kernel).
+// The estimate is unbiased for any chain length: the starts are drawn from the pool in proportion
+// to f (over the chains) with b from the same pool, so E[b mean_c h(X_0,c)] = E[(1/B) sum_i f_i
+// h(x_i)] = integral of f h, and each step preserves it (f-invariance of the kernel).
 //
-// Direct light (RenderSettings::mltDirectSpp > 0, the default; Mitsuba's pssmlt "directSamples"):
-// the chains' f is the luminance of the indirect light only (Globals.radiancePart: light that
-// reached the camera after two or more scatterings), and every iteration also traces mltDirectSpp
-// direct-light-only paths per pixel (emission seen by the camera, NEE and MIS-weighted emitter hits
-// at its first hit; the paths end at their second vertex) whose mean goes into the film beside the
-// splats. The parts keep the full estimator's MIS weights, so their sum is the whole estimate; the
-// chains spend their mutations where Metropolis pays. 0: the whole path contribution is the
-// chains' f.
+// Part of the light outside the chains (RenderSettings::mltPassSpp > 0, the default): the chains'
+// f is the luminance of one part of each path's radiance (Globals.radiancePart,
+// RenderSettings::mltChainLight), and every iteration (mltSteps steps of every chain) also traces
+// mltPassSpp paths per pixel for the rest, with the path tracer's own numbers, whose mean goes
+// into the film beside the splats. The parts keep the full estimator's MIS weights, so their sum
+// is the whole estimate; the chains spend their mutations where Metropolis pays.
+// - caustic (the default): the chains carry light that reached a non-delta vertex through delta
+//   bounces from the light (L S+ D ... E), which next-event estimation cannot sample; the pass the
+//   rest. In a scene without delta lobes the chains stay idle and the pass is the path tracer.
+// - indirect (Mitsuba's pssmlt "directSamples"): the chains carry light after two or more
+//   scatterings; the pass direct light only (its paths end at their second vertex).
+// 0: the whole path contribution is the chains' f.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -45,20 +50,31 @@ struct MltReport {
   double bPrime = 0;            // b' of Kelemen's weights (0: plain splats), from other paths
   std::uint32_t chains = 0, bootstrapPaths = 0, dims = 0;
   std::uint64_t nonzeroBootstrap = 0;  // bootstrap paths with f > 0
+  bool noCaustics = false;      // caustic chains in a scene without delta lobes: no bootstrap, chains idle
   double bootstrapSeconds = 0;  // wall time of the bootstrap (its paths, b, the chains' starts)
   double acceptance() const { return proposals ? double(accepted) / double(proposals) : 0.0; }
+};
+
+// What the integrator needs to know of the scene.
+struct MltScene {
+  bool deltaMaterials = true;  // some material (or component) has a delta lobe: caustic light is possible
 };
 
 class MltIntegrator : public PrimarySampleIntegrator {
  public:
   // paths: the path tracer, created with PathOptions{primaryDimsFor(maxDepth), imageSamples,
-  // capacity = settings.mltChains}.
+  // capacity = pathSlotsFor(settings, pixels)}.
   MltIntegrator(vk::Context& ctx, StageGlobals& globals, const RenderSettings& settings,
-                std::unique_ptr<PathIntegrator> paths, std::uint64_t pixels);
+                std::unique_ptr<PathIntegrator> paths, std::uint64_t pixels, MltScene scene = {});
   ~MltIntegrator() override;
 
+  // The path tracer's slots for a Metropolis render: one per chain, and at least as many as the
+  // path-traced pass of the light outside the chains can fill (its samples of every pixel per
+  // iteration, up to 2^16: a pass traced in chunks of a few thousand paths cost a quarter more).
+  static std::uint32_t pathSlotsFor(const RenderSettings& settings, std::uint64_t pixels);
   // Device bytes of the chains' state beyond the path tracer's.
-  static std::uint64_t bytesFor(std::uint32_t chains, std::uint32_t dims, std::uint32_t bootstrap, std::uint64_t pixels);
+  static std::uint64_t bytesFor(std::uint32_t chains, std::uint32_t slots, std::uint32_t dims, std::uint32_t bootstrap,
+                                std::uint64_t pixels);
   // Mutations per chain per pass when RenderSettings::samplesPerPass is 0: about 2^18 paths per
   // pass (the path tracer's count on a CPU device: a time budget ends within a few seconds on
   // lavapipe), at least 1.
@@ -83,13 +99,14 @@ class MltIntegrator : public PrimarySampleIntegrator {
   // The part of a path's radiance that is the chains' f (RADIANCE_*: all, or indirect light when
   // direct light is outside the chain).
   std::uint32_t chainPart() const;
-  // Direct light outside the chain: settings.mltDirectSpp x samples direct-light-only paths per
+  // Direct light outside the chain: settings.mltPassSpp x samples direct-light-only paths per
   // pixel (each trace: as many samples of every pixel as the chains' path slots hold), each added
-  // to the film / mltDirectSpp.
-  void directPass(std::uint32_t sampleIndex, std::uint32_t samples);
+  // to the film / mltPassSpp.
+  void outsidePass(std::uint32_t sampleIndex, std::uint32_t samples);
 
   std::uint32_t m_chains = 0, m_dims = 0, m_poolSize = 0;
   bool m_bootstrapped = false;
+  MltScene m_scene;
   MltReport m_report;
   std::vector<float> m_poolValues;
   vk::Buffer* m_mlt = nullptr;  // the GpuMlt (host visible)

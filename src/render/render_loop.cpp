@@ -28,8 +28,10 @@ RenderLoop::RenderLoop(Renderer& renderer, RenderRecord base, const RenderRecord
   m_base.settings.guideTrainPass = m_renderer.settings().guideTrainPass;  // resolved by the renderer too
   if (m_options.progress) {
     const RenderSettings& s = m_renderer.settings();
-    // Paths per spp: one per pixel, or one mutation per chain for Metropolis (docs/mlt.md).
-    const std::uint64_t paths = m_renderer.mlt() ? m_renderer.mlt()->report().chains : std::uint64_t(s.width) * s.height;
+    // Paths per spp: one per pixel, or the mutations of an iteration for Metropolis (chains x
+    // steps; docs/mlt.md).
+    const std::uint64_t paths = m_renderer.mlt() ? std::uint64_t(m_renderer.mlt()->report().chains) * s.mltSteps
+                                                 : std::uint64_t(s.width) * s.height;
     m_progress = std::make_unique<Progress>("render", m_options.spp, paths, false, m_options.quiet);
     m_progress->update(m_renderer.samplesDone());
   }

@@ -41,6 +41,15 @@ bool parseCamera(const std::string& text, Camera& c) {
 }  // namespace
 
 
+// What a Metropolis render's chains carry and how many path-traced samples add the rest ("" for
+// other integrators).
+std::string mltSplitText(const RenderSettings& s) {
+  if (s.integrator != IntegratorKind::Mlt) return "";
+  if (!s.mltPassSpp) return "all light in the chains, " + std::to_string(s.mltSteps) + " step(s) of every chain per iteration";
+  return mltChainLightName(s.mltChainLight) + " light in the chains, " + std::to_string(s.mltPassSpp) +
+         " path-traced sample(s) per pixel per " + std::to_string(s.mltSteps) + " step(s) of every chain";
+}
+
 std::string describeEnvironment(const Scene& scene) {
   const Environment e = effectiveEnvironment(scene);
   if (e.kind == EnvironmentKind::Map) return "map " + e.path;
@@ -127,7 +136,9 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
       meta.doubles.push_back({"nusselt/mltLargeStep", r.settings.mltLargeStep});
       meta.doubles.push_back({"nusselt/mltSigma", r.settings.mltSigma});
       meta.ints.push_back({"nusselt/mltKelemen", r.settings.mltKelemen ? 1 : 0});
-      meta.ints.push_back({"nusselt/mltDirectSpp", r.settings.mltDirectSpp});
+      meta.ints.push_back({"nusselt/mltPassSpp", r.settings.mltPassSpp});
+      meta.ints.push_back({"nusselt/mltSteps", r.settings.mltSteps});
+      if (r.settings.mltPassSpp) meta.strings.push_back({"nusselt/mltChainLight", mltChainLightName(r.settings.mltChainLight)});
     }
     if (r.settings.integrator == IntegratorKind::Vegas) {
       meta.ints.push_back({"nusselt/vegasBins", r.settings.vegasBins});
@@ -140,11 +151,7 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
         value = (mlt ? "primary-sample-space Metropolis (PSSMLT) over the wavefront path tracer ("
                      : "VEGAS (separable warp of the first bounces' primary draws, learned per pass) over the "
                        "wavefront path tracer (") +
-                value + ")" +
-                (mlt && r.settings.mltDirectSpp
-                     ? "; direct light outside the chains, " + std::to_string(r.settings.mltDirectSpp) +
-                           " direct-only path sample(s) per pixel per mutation"
-                     : "");
+                value + ")" + (mlt ? "; " + mltSplitText(r.settings) : "");
   }
   if (r.source == "preview") meta.doubles.push_back({"nusselt/exposure", r.displayExposure});
   return meta;
@@ -224,8 +231,16 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
     r.settings.mltSigma = static_cast<float>(findDouble(meta, "nusselt/mltSigma").value_or(0.01));
     // Renders written before the key used the plain weights.
     r.settings.mltKelemen = findInt(meta, "nusselt/mltKelemen").value_or(0) != 0;
-    // Renders written before the key kept direct light in the chain.
-    r.settings.mltDirectSpp = static_cast<std::uint32_t>(findInt(meta, "nusselt/mltDirectSpp").value_or(0));
+    // The path-traced samples of the light outside the chains: "mltDirectSpp" in renders written
+    // before the caustic split (their chains carried indirect light), absent before the direct
+    // pass (all light in the chains).
+    // Renders written before the key moved every chain once per iteration.
+    r.settings.mltSteps = static_cast<std::uint32_t>(findInt(meta, "nusselt/mltSteps").value_or(1));
+    const auto passSpp = findInt(meta, "nusselt/mltPassSpp");
+    r.settings.mltPassSpp = static_cast<std::uint32_t>(passSpp ? *passSpp : findInt(meta, "nusselt/mltDirectSpp").value_or(0));
+    const std::string chainLight = findString(meta, "nusselt/mltChainLight").value_or(passSpp ? "" : "indirect");
+    if (r.settings.mltPassSpp && !parseMltChainLight(chainLight, r.settings.mltChainLight))
+      throw Error(path + ": header attribute nusselt/mltChainLight: '" + chainLight + "' is not caustic or indirect");
   }
   if (r.settings.integrator == IntegratorKind::Vegas) {
     r.settings.vegasBins = static_cast<std::uint32_t>(findInt(meta, "nusselt/vegasBins").value_or(64));
@@ -285,9 +300,7 @@ std::string firstDifference(const RenderRecord& a, const RenderRecord& b) {
         differ("the environment's selection (--env-select)", a.envSelect, b.envSelect),
         differ("path guiding (--guiding)", s.guiding ? "on" : "off", t.guiding ? "on" : "off"),
         // Compared when either is a Metropolis render.
-        differ("mlt's direct light outside the chain (--mlt-direct-spp)",
-               s.integrator == IntegratorKind::Mlt || t.integrator == IntegratorKind::Mlt ? std::to_string(s.mltDirectSpp) : "",
-               s.integrator == IntegratorKind::Mlt || t.integrator == IntegratorKind::Mlt ? std::to_string(t.mltDirectSpp) : "")})
+        differ("mlt's light outside the chains and steps (--mlt-chain-light, --mlt-pass-spp, --mlt-steps)", mltSplitText(s), mltSplitText(t))})
     if (!d.empty()) return d;
   return {};
 }

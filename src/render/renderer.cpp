@@ -94,7 +94,8 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
     m_samplesPerPass = mlt ? std::min(MltIntegrator::iterationsPerPassFor(settings), std::max(settings.spp, 1u))
                            : PathIntegrator::samplesPerPassFor(settings, pixels,
                                                                m_ctx.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
-    const std::uint32_t capacity = mlt ? settings.mltChains : PathIntegrator::capacityFor(settings, pixels, m_samplesPerPass);
+    const std::uint32_t capacity = mlt ? MltIntegrator::pathSlotsFor(settings, pixels)
+                                       : PathIntegrator::capacityFor(settings, pixels, m_samplesPerPass);
     const std::uint32_t primaryDims = settings.primarySamples || mlt ? PathIntegrator::primaryDimsFor(settings.maxDepth)
                                       : vegas                        ? shared::vegasPrimaryDims(settings.vegasBounces)
                                                                      : 0;
@@ -117,7 +118,7 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
                                std::max<std::size_t>(scene.materials.size(), 1) * sizeof(shared::GpuMaterial) +
                                Film::bytesFor(pixels) +
                                PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS, primaryDims) +
-                               (mlt ? MltIntegrator::bytesFor(capacity, primaryDims, mltBootstrapPaths(settings), pixels) : 0) +
+                               (mlt ? MltIntegrator::bytesFor(settings.mltChains, capacity, primaryDims, mltBootstrapPaths(settings), pixels) : 0) +
                                (vegas ? VegasIntegrator::bytesFor(settings) : 0) +
                                (settings.guiding ? DeviceGuide::bytesFor(settings.guideMemory, capacity, settings.maxDepth) : 0);
     const std::uint64_t have = vk::deviceLocalHeapSize(m_ctx);
@@ -201,14 +202,20 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
   else if (vegas) paths.primaryDims = shared::vegasPrimaryDims(settings.vegasBounces);
   if (mlt) {
     paths.imageSamples = true;
-    paths.capacity = settings.mltChains;
+    paths.capacity = MltIntegrator::pathSlotsFor(settings, pixels);
   }
   auto integrator = std::make_unique<PathIntegrator>(m_ctx, *m_globals, m_settings, m_materials->slotKeys(), pixels,
                                                      m_samplesPerPass, m_materials->slotNames(), m_guide.get(), paths);
   m_summary.pipelineSeconds = integrator->pipelineSeconds();
   m_paths = integrator.get();
   if (mlt) {
-    auto chains = std::make_unique<MltIntegrator>(m_ctx, *m_globals, m_settings, std::move(integrator), pixels);
+    MltScene chainScene;
+    chainScene.deltaMaterials = false;
+    for (const Material& m : scene.materials) {
+      chainScene.deltaMaterials |= m.components.empty() && shared::modelIsDelta(m.model);
+      for (const MaterialComponent& c : m.components) chainScene.deltaMaterials |= shared::modelIsDelta(c.model);
+    }
+    auto chains = std::make_unique<MltIntegrator>(m_ctx, *m_globals, m_settings, std::move(integrator), pixels, chainScene);
     m_mlt = chains.get();
     m_integrator = std::move(chains);
   } else if (vegas) {

@@ -116,6 +116,13 @@ inline const char* traversalName(Traversal t) { return enumName(kTraversalNames,
 inline bool parseTraversal(const std::string& name, Traversal& t) { return parseEnum(kTraversalNames, name, t); }
 inline const char* integratorName(IntegratorKind k) { return enumName(kIntegratorNames, k); }
 inline bool parseIntegrator(const std::string& name, IntegratorKind& k) { return parseEnum(kIntegratorNames, name, k); }
+// RenderSettings::mltChainLight's names (--mlt-chain-light, the header's nusselt/mltChainLight).
+inline std::string mltChainLightName(std::uint32_t part) { return part == RADIANCE_INDIRECT ? "indirect" : "caustic"; }
+inline bool parseMltChainLight(const std::string& name, std::uint32_t& part) {
+  if (name != "caustic" && name != "indirect") return false;
+  part = name == "indirect" ? RADIANCE_INDIRECT : RADIANCE_CAUSTIC;
+  return true;
+}
 
 struct RenderSettings {
   IntegratorKind integrator = IntegratorKind::Path;
@@ -200,25 +207,36 @@ struct RenderSettings {
   // (Metropolis sets its own, mlt_integrator.h).
   std::uint32_t radiancePart = 0;
   // Metropolis (--integrator mlt, docs/mlt.md). Chains in flight (`--mlt-chains`; each a path slot
-  // and a primary sample vector of PathIntegrator::primaryDimsFor(maxDepth) draws).
-  std::uint32_t mltChains = 65536;
+  // and a primary sample vector of PathIntegrator::primaryDimsFor(maxDepth) draws). 4096 with 8
+  // steps per iteration: caustic chains start from the bootstrap's few caustic paths, and fewer,
+  // longer chains were better at equal time on lavapipe (docs/mlt.md, "Caustic chains").
+  std::uint32_t mltChains = 4096;
   // Independent paths of the bootstrap (`--mlt-bootstrap`): the normalisation b and the chains'
-  // starts come from them; 0 = 16 x chains (docs/mlt.md: with 4 x chains the glass box's error at
+  // starts come from them; 0 = 16 x chains, at least 2^20 (docs/mlt.md: with 4 x chains the glass box's error at
   // equal time was about twice as large).
   std::uint32_t mltBootstrap = 0;
-  // Probability of a large step (`--mlt-large-step`; Kelemen et al. and pbrt: 0.3).
-  float mltLargeStep = 0.3f;
+  // Probability of a large step (`--mlt-large-step`; Kelemen et al. and pbrt: 0.3; caustic chains
+  // accept 0.1 % of them, docs/mlt.md).
+  float mltLargeStep = 0.1f;
   // Standard deviation of a small step's move per coordinate (`--mlt-sigma`; pbrt: 0.01).
   float mltSigma = 0.01f;
   // Splat weights (`--mlt-weights`): Kelemen et al.'s combination of the chain with its large steps
   // (each large step's path also counts as an independent path-tracer sample, both weighted by
   // 1 / (f / b' + p_large)), or the plain expected-value splats (false). docs/mlt.md.
   bool mltKelemen = true;
-  // Direct light outside the chain (`--mlt-direct-spp`, Mitsuba's directSamples): the chains' f is
-  // the indirect light only (Globals.radiancePart) and every iteration adds this many direct-light-
-  // only path-tracer samples per pixel beside the splats; 0: the whole path contribution is the
-  // chains' f (docs/mlt.md).
-  std::uint32_t mltDirectSpp = 1;
+  // The light the chains carry (`--mlt-chain-light`; RADIANCE_CAUSTIC or RADIANCE_INDIRECT,
+  // layout.h) when mltPassSpp > 0: the rest is path-traced per pixel beside the splats. Caustic:
+  // only light that reached a non-delta vertex through delta bounces from the light (paths the
+  // path tracer's next-event estimation cannot sample; Metropolis only where path tracing fails);
+  // indirect: light after two or more scatterings (Mitsuba's pssmlt). docs/mlt.md.
+  std::uint32_t mltChainLight = RADIANCE_CAUSTIC;
+  // Steps of every chain per iteration (`--mlt-steps`): an iteration (a sample per pixel of the
+  // render's count) moves each chain this many times and path-traces mltPassSpp samples of every
+  // pixel for the light outside the chains, so this sets the share of mutations in the time.
+  std::uint32_t mltSteps = 8;
+  // Path-traced samples per pixel per iteration of the light outside the chains (`--mlt-pass-spp`,
+  // formerly `--mlt-direct-spp`); 0: the chains carry all light (docs/mlt.md).
+  std::uint32_t mltPassSpp = 1;
   // VEGAS (--integrator vegas, docs/vegas.md). Bins per warped axis (`--vegas-bins`, 1 .. 4096).
   std::uint32_t vegasBins = 64;
   // Bounces whose light choice, light point and BSDF draws are warped (`--vegas-bounces`, 1 ..
@@ -231,7 +249,8 @@ struct RenderSettings {
 
 // The bootstrap paths of a Metropolis render (RenderSettings::mltBootstrap resolved).
 inline std::uint32_t mltBootstrapPaths(const RenderSettings& s) {
-  return s.mltBootstrap ? s.mltBootstrap : static_cast<std::uint32_t>(std::min<std::uint64_t>(16ull * s.mltChains, 1u << 30));
+  return s.mltBootstrap ? s.mltBootstrap
+                        : static_cast<std::uint32_t>(std::min<std::uint64_t>(std::max<std::uint64_t>(16ull * s.mltChains, 1u << 20), 1u << 30));
 }
 
 // The training samples per pixel of a guided render: settings.guideTrainSpp, or when 0 the

@@ -44,12 +44,20 @@ cp "$work/mlt.exr" "$work/resume.exr"
 if "$nusselt" render "${small[@]}" --resume "$work/resume.exr" --spp 4 2>"$work/err"; then fail "path resume of an mlt render"
 elif ! grep -qF "integrator" "$work/err"; then fail "resume message: $(cat "$work/err")"
 else echo "ok   mlt_resume_as_path: $(cat "$work/err")"; fi
-# Direct light outside the chain is recorded (the default, 1) and resuming with another value is refused.
-[ "$("$nusselt" info "$work/resume.exr" | sed -n 's/^  nusselt\/mltDirectSpp: //p')" = 1 ] || fail "mlt header: mltDirectSpp"
-if "$nusselt" render "${small[@]}" --integrator mlt --mlt-chains 1024 --mlt-direct-spp 0 --resume "$work/resume.exr" \
-  --spp 4 2>"$work/err"; then fail "mlt resume with another --mlt-direct-spp"
-elif ! grep -qF -- "--mlt-direct-spp" "$work/err"; then fail "resume message: $(cat "$work/err")"
-else echo "ok   mlt_resume_direct_spp: $(cat "$work/err")"; fi
+# The light outside the chains is recorded (the defaults: caustic chains, 1 path-traced sample per
+# pixel per 8 steps) and resuming with another split or step count is refused.
+[ "$("$nusselt" info "$work/resume.exr" | sed -n 's/^  nusselt\/mltPassSpp: //p')" = 1 ] || fail "mlt header: mltPassSpp"
+[ "$("$nusselt" info "$work/resume.exr" | sed -n 's/^  nusselt\/mltChainLight: //p')" = caustic ] || fail "mlt header: mltChainLight"
+[ "$("$nusselt" info "$work/resume.exr" | sed -n 's/^  nusselt\/mltSteps: //p')" = 8 ] || fail "mlt header: mltSteps"
+for other in "--mlt-direct-spp 0" "--mlt-pass-spp 2" "--mlt-chain-light indirect" "--mlt-steps 4"; do
+  # shellcheck disable=SC2086
+  if "$nusselt" render "${small[@]}" --integrator mlt --mlt-chains 1024 $other --resume "$work/resume.exr" \
+    --spp 4 2>"$work/err"; then fail "mlt resume with $other"
+  elif ! grep -qF -- "--mlt-chain-light, --mlt-pass-spp, --mlt-steps" "$work/err"; then fail "resume message: $(cat "$work/err")"
+  else echo "ok   mlt_resume_with $other: $(cat "$work/err")"; fi
+done
+expect_error mlt_chain_light "--mlt-chain-light" -- --integrator mlt --mlt-chain-light direct
+expect_error mlt_steps "--mlt-steps" -- --integrator mlt --mlt-steps 0
 "$nusselt" render "${small[@]}" --integrator mlt --mlt-chains 1024 --resume "$work/resume.exr" --spp 4 \
   || fail "mlt resume"
 [ "$("$nusselt" info "$work/resume.exr" | sed -n 's/^  nusselt\/spp: //p')" = 4 ] || fail "mlt resume: spp in the header"

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 
@@ -19,37 +20,53 @@ namespace {
 Scene cornell() { return test::defaultScene(); }
 RenderSettings base(std::uint32_t seed) { return test::integratorSettings(seed); }
 
+// The Cornell box has no delta lobe, hence no caustic light: its tests put indirect light in the
+// chains (or all of it: mltPassSpp 0), one step per iteration and the anchors' large-step
+// probability, as they were measured with.
 RenderSettings mltSettings(std::uint32_t seed, std::uint32_t chains, std::uint32_t iterations) {
   RenderSettings s = base(seed);
   s.integrator = IntegratorKind::Mlt;
   s.mltChains = chains;
   s.spp = iterations;
+  s.mltChainLight = RADIANCE_INDIRECT;
+  s.mltSteps = 1;
+  s.mltLargeStep = 0.3f;
   return s;
 }
 
-// Mean of `seeds` Metropolis renders against a path-traced reference, per block and for the
-// whole image: Welch-style t with the seeds' sample variance (the only honest variance of a
-// correlated estimate) plus the reference's; each test two-sided at 0.001 / tests (Bonferroni).
-// The bootstrap's pool is large (2^17 paths): its estimate of b carries most of a short render's
-// variance (a 2 % error with the default 4 x 4096 paths), which would hide a bias of that size.
-void expectMltMatchesPath(std::uint32_t chains, std::uint32_t iterations, int seeds,
-                          std::uint32_t directSpp = RenderSettings{}.mltDirectSpp) {
-  Scene scene = cornell();
+// The glass box (a glass sphere under the light of the Cornell box: caustic light on the floor).
+Scene glassBox() { return test::loadTestScene("scenes/cornell/cornell-glass.glb"); }
+
+// Mean of `seeds` Metropolis renders (settings ms, seeds 10, 11, ...) against a path-traced
+// reference, per block and for the whole image: Welch-style t with the seeds' sample variance (the
+// only honest variance of a correlated estimate) plus the reference's; each test two-sided at
+// 0.001 / tests (Bonferroni).
+void expectMltMatchesPath(const Scene& scene, RenderSettings ms, int seeds, std::uint32_t referenceSpp = 8192) {
   RenderSettings ps = base(1000);
-  ps.spp = 8192;
+  ps.spp = referenceSpp;
   test::Rendered ref = test::render(scene, ps);
   std::vector<Image> replicas;
   for (int k = 0; k < seeds; ++k) {
-    RenderSettings ms = mltSettings(10 + k, chains, iterations);
-    ms.mltBootstrap = 1u << 17;
-    ms.mltDirectSpp = directSpp;
+    ms.seed = 10 + k;
     test::Rendered r = test::render(scene, ms);
     EXPECT_EQ(r.stats.nonFiniteSamples, 0u);
     replicas.push_back(std::move(r.image));
   }
   test::expectReplicasMatchReference(ref.image, replicas, "mlt",
-                                     std::to_string(chains) + " chains x " + std::to_string(iterations) +
-                                         " mutations, direct spp " + std::to_string(directSpp));
+                                     std::to_string(ms.mltChains) + " chains x " + std::to_string(ms.spp) + " x " +
+                                         std::to_string(ms.mltSteps) + " mutations, " + mltChainLightName(ms.mltChainLight) +
+                                         " chains, pass spp " + std::to_string(ms.mltPassSpp));
+}
+
+// On the Cornell box, indirect light in the chains (mltSettings). The bootstrap's pool is large
+// (2^17 paths): its estimate of b carries most of a short render's variance (a 2 % error with
+// 4 x 4096 paths), which would hide a bias of that size.
+void expectMltMatchesPath(std::uint32_t chains, std::uint32_t iterations, int seeds,
+                          std::uint32_t directSpp = RenderSettings{}.mltPassSpp) {
+  RenderSettings ms = mltSettings(0, chains, iterations);
+  ms.mltBootstrap = 1u << 17;
+  ms.mltPassSpp = directSpp;
+  expectMltMatchesPath(cornell(), ms, seeds);
 }
 
 }  // namespace
@@ -71,14 +88,15 @@ TEST(Mlt, ShortChainsMatchThePathTracer) { expectMltMatchesPath(4096, 10, 10, 0)
 // mean's error 5x that of the chains: 0.0061 against 0.0011).
 TEST(Mlt, DirectOutsideTheChainMatchesThePathTracer) { expectMltMatchesPath(4096, 10, 10, 16); }
 
-// The path tracer's radiance split by depth (RenderSettings::radiancePart, Globals.radiancePart):
-// direct-only plus indirect-only renders estimate the full render. Independent seeds, 1024 spp
-// each: per 4 x 4 block and for the image, z of (direct + indirect - full) with the three renders'
+// The path tracer's radiance split in two parts (RenderSettings::radiancePart, Globals.radiancePart,
+// RADIANCE_* in layout.h): part a plus part b estimates the full render. Independent seeds, 1024
+// spp each: per 4 x 4 block and for the image, z of (a + b - full) with the three renders'
 // variances of the mean (blockMeans' bound), two-sided at 0.001 / tests (Bonferroni). Then with one
 // seed: the parts read the same draws with the full estimator's MIS weights, so path by path they
-// sum to the full radiance, and the images to the full image up to float rounding.
-TEST(Mlt, DirectAndIndirectPartsSumToTheFullPathTracer) {
-  Scene scene = cornell();
+// sum to the full radiance, and the images to the full image up to float rounding. Returns the
+// image means of a and b (seed 1) and the full render.
+std::array<double, 3> expectPartsSumToFull(const Scene& scene, std::uint32_t partA, std::uint32_t partB, const char* nameA,
+                                           const char* nameB) {
   auto render = [&](std::uint32_t part, std::uint32_t seed) {
     RenderSettings s = base(seed);
     s.spp = 1024;
@@ -87,32 +105,95 @@ TEST(Mlt, DirectAndIndirectPartsSumToTheFullPathTracer) {
     EXPECT_EQ(r.stats.nonFiniteSamples, 0u);
     return r.image;
   };
-  const Image full = render(RADIANCE_ALL, 1), direct = render(RADIANCE_DIRECT, 2), indirect = render(RADIANCE_INDIRECT, 3);
-  std::vector<double> mf, vf, md, vd, mi, vi;
+  const Image full = render(RADIANCE_ALL, 1), a = render(partA, 2), b = render(partB, 3);
+  std::vector<double> mf, vf, ma, va, mb, vb;
   test::blockMeans(full, mf, &vf);
-  test::blockMeans(direct, md, &vd);
-  test::blockMeans(indirect, mi, &vi);
+  test::blockMeans(a, ma, &va);
+  test::blockMeans(b, mb, &vb);
   const std::size_t tests = mf.size();
   const double alpha = 0.001 / double(tests);
-  for (std::size_t b = 0; b < tests; ++b) {
-    const double z = (md[b] + mi[b] - mf[b]) / std::sqrt(vd[b] + vi[b] + vf[b]);
-    EXPECT_GT(test::normalPValue(z), alpha) << (b + 1 == tests ? "image" : "block " + std::to_string(b)) << ": direct "
-                                            << md[b] << " + indirect " << mi[b] << " vs full " << mf[b] << " (z " << z << ")";
+  for (std::size_t k = 0; k < tests; ++k) {
+    const double z = (ma[k] + mb[k] - mf[k]) / std::sqrt(va[k] + vb[k] + vf[k]);
+    EXPECT_GT(test::normalPValue(z), alpha) << (k + 1 == tests ? "image" : "block " + std::to_string(k)) << ": " << nameA
+                                            << " " << ma[k] << " + " << nameB << " " << mb[k] << " vs full " << mf[k]
+                                            << " (z " << z << ")";
   }
-  std::printf("direct %.5f + indirect %.5f = %.5f vs full %.5f (z %.2f)\n", md.back(), mi.back(), md.back() + mi.back(),
-              mf.back(), (md.back() + mi.back() - mf.back()) / std::sqrt(vd.back() + vi.back() + vf.back()));
+  std::printf("%s %.5f + %s %.5f = %.5f vs full %.5f (z %.2f)\n", nameA, ma.back(), nameB, mb.back(), ma.back() + mb.back(),
+              mf.back(), (ma.back() + mb.back() - mf.back()) / std::sqrt(va.back() + vb.back() + vf.back()));
   // Seed 1 for both parts: the full image up to rounding (a sum of 1024 paths per pixel).
-  const Image d1 = render(RADIANCE_DIRECT, 1), i1 = render(RADIANCE_INDIRECT, 1);
+  const Image a1 = render(partA, 1), b1 = render(partB, 1);
   double worst = 0;
   for (std::size_t k = 0; k < full.rgb.size(); ++k) {
-    const double sum = double(d1.rgb[k]) + double(i1.rgb[k]);
+    const double sum = double(a1.rgb[k]) + double(b1.rgb[k]);
     worst = std::max(worst, std::abs(sum - double(full.rgb[k])) / (std::abs(double(full.rgb[k])) + 1e-6));
   }
-  std::printf("same seed: max relative |direct + indirect - full| %.3g\n", worst);
+  std::printf("same seed: max relative |%s + %s - full| %.3g\n", nameA, nameB, worst);
   EXPECT_LT(worst, 1e-4);
+  EXPECT_EQ(test::validationMessages(), 0u);
+  std::vector<double> m1;
+  test::blockMeans(a1, m1, nullptr);
+  const double meanA = m1.back();
+  test::blockMeans(b1, m1, nullptr);
+  return {meanA, m1.back(), mf.back()};
+}
+
+// Split by depth: direct light (at most one scattering) and indirect light.
+TEST(Mlt, DirectAndIndirectPartsSumToTheFullPathTracer) {
+  const auto [direct, indirect, full] = expectPartsSumToFull(cornell(), RADIANCE_DIRECT, RADIANCE_INDIRECT, "direct", "indirect");
   // Each part is a real part: the direct image is not the full one, nor is the indirect one zero.
-  EXPECT_LT(md.back(), 0.9 * mf.back());
-  EXPECT_GT(mi.back(), 0.1 * mf.back());
+  EXPECT_LT(direct, 0.9 * full);
+  EXPECT_GT(indirect, 0.1 * full);
+}
+
+// Split by caustics: light that reached a non-delta vertex through delta bounces from the light,
+// and the rest, on the glass box (its sphere focuses the light onto the floor).
+TEST(Mlt, CausticAndNonCausticPartsSumToTheFullPathTracer) {
+  const auto [caustic, rest, full] = expectPartsSumToFull(glassBox(), RADIANCE_CAUSTIC, RADIANCE_NONCAUSTIC, "caustic", "non-caustic");
+  // Both parts are real parts: the caustic is a few per cent of the image.
+  EXPECT_GT(caustic, 0.005 * full);
+  EXPECT_LT(rest, 0.995 * full);
+}
+
+// Caustic light in the chains (the default), the rest path-traced per pixel, several steps of every
+// chain per iteration: the glass box's image in expectation. A pool of 2^20 paths and 16 pass
+// samples per pixel per iteration (4096 paths, as many as the chains' steps per iteration); the
+// reference at 2^16 spp. The caustic is 1.5 % of this image (0.0026 of 0.170), 12 % of the two
+// blocks under the sphere: without the chains those fail at t -12.9; a chain part 20 % off passes
+// (t -3.2 at 0.8): the chains' weights are tested sharply on the Cornell box above (same kernels).
+TEST(Mlt, CausticChainsMatchThePathTracer) {
+  RenderSettings ms = base(0);
+  ms.integrator = IntegratorKind::Mlt;
+  ms.mltChains = 1024;
+  ms.mltSteps = 4;
+  ms.spp = 10;
+  ms.mltPassSpp = 16;
+  ms.mltBootstrap = 1u << 20;
+  expectMltMatchesPath(glassBox(), ms, 10, 1u << 16);
+}
+
+// Caustic chains in a scene without delta lobes: no path carries caustic light, so the chains stay
+// idle (no bootstrap, no mutation) and the path-traced pass is the whole render. It draws the path
+// tracer's own numbers of each pixel and sample, so the image is the path tracer's up to rounding
+// (the camera draw goes through image coordinates).
+TEST(Mlt, WithoutDeltaLobesThePassIsThePathTracer) {
+  Scene scene = cornell();
+  RenderSettings ms = base(7);
+  ms.integrator = IntegratorKind::Mlt;
+  ms.spp = 16;
+  Renderer r(test::context(), scene, ms);
+  r.render(ms.spp);
+  EXPECT_TRUE(r.mlt()->report().noCaustics);
+  EXPECT_EQ(r.mlt()->report().proposals, 0u);
+  RenderSettings ps = base(7);
+  ps.spp = 16;
+  const Image path = test::render(scene, ps).image;
+  const Image mlt = r.image();
+  ASSERT_EQ(mlt.rgb.size(), path.rgb.size());
+  double worst = 0;
+  for (std::size_t k = 0; k < path.rgb.size(); ++k)
+    worst = std::max(worst, std::abs(double(mlt.rgb[k]) - double(path.rgb[k])) / (std::abs(double(path.rgb[k])) + 1e-6));
+  std::printf("caustic mlt without delta lobes against the path tracer: max relative difference %.3g\n", worst);
+  EXPECT_LT(worst, 1e-4);
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
