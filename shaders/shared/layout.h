@@ -93,9 +93,9 @@ NUSSELT_STATS(NUSSELT_STAT_INDEX)
 // from the light (paths L S+ D ... E: an emitter hit or an escape after a delta bounce, with a
 // non-delta bounce before it), the light that next-event estimation cannot sample: the first such
 // contribution of a path (a caustic-only path ends there); non-caustic light is the rest (later
-// caustic contributions included). Each pair splits every contribution into exactly one part, and the parts use
-// the full estimator's MIS weights, so direct + indirect = caustic + non-caustic = all, path by
-// path (Metropolis with part of the light outside the chains: docs/mlt.md).
+// caustic contributions included). Each pair splits every contribution into exactly one part, and
+// the parts use the full estimator's MIS weights, so direct + indirect = caustic + non-caustic =
+// all, path by path (Metropolis with part of the light outside the chains: docs/mlt.md).
 #define RADIANCE_ALL 0u
 #define RADIANCE_DIRECT 1u
 #define RADIANCE_INDIRECT 2u

@@ -64,7 +64,7 @@ struct RenderArgs {
   float mltSigma = RenderSettings{}.mltSigma;
   std::string mltWeights = "kelemen";
   std::uint32_t mltPassSpp = RenderSettings{}.mltPassSpp;
-  std::string mltChainLight = "caustic";
+  std::string mltChainLight = mltChainLightName(RenderSettings{}.mltChainLight);
   std::uint32_t mltSteps = RenderSettings{}.mltSteps;
   std::uint32_t vegasBins = 64;
   std::uint32_t vegasBounces = 1;
@@ -133,7 +133,8 @@ int renderCommand(const RenderArgs& a) {
   s.mltKelemen = a.mltWeights == "kelemen";
   s.mltPassSpp = a.mltPassSpp;
   s.mltSteps = a.mltSteps;
-  s.mltChainLight = a.mltChainLight == "indirect" ? RADIANCE_INDIRECT : RADIANCE_CAUSTIC;
+  if (!parseMltChainLight(a.mltChainLight, s.mltChainLight))
+    throw Error("--mlt-chain-light " + a.mltChainLight + ": caustic or indirect");
   s.vegasBins = a.vegasBins;
   s.vegasBounces = a.vegasBounces;
   s.vegasAlpha = a.vegasAlpha;
@@ -882,7 +883,7 @@ int runCli(int argc, char** argv) {
                                                  "the render's count, with --mlt-pass-spp path-traced samples)")
       ->capture_default_str()->check(CLI::Range(1u, 1024u));
   render->add_option("--mlt-pass-spp,--mlt-direct-spp", ra.mltPassSpp,
-                     "mlt: path-traced samples per pixel per mutation of the light the chains do not carry "
+                     "mlt: path-traced samples per pixel per iteration of the light the chains do not carry "
                      "(--mlt-chain-light); 0: the chains carry all light (docs/mlt.md)")
       ->capture_default_str()->check(CLI::Range(0u, 64u));
   render->add_option("--vegas-bins", ra.vegasBins, "vegas: bins of each warped axis's density (1 .. 4096)")

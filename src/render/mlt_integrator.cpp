@@ -37,7 +37,8 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
     : PrimarySampleIntegrator(ctx, globals, settings, std::move(paths), pixels), m_scene(scene) {
   m_chains = settings.mltChains;
   m_dims = globals.host().primaryDims;
-  if (m_dims == 0 || m_chains == 0 || m_paths->capacity() < m_chains) throw Error("mlt: the path tracer has no primary samples");
+  if (m_dims == 0 || m_chains == 0) throw Error("mlt: the path tracer has no primary samples");
+  if (m_paths->capacity() < m_chains) throw Error("mlt: the path tracer has fewer path slots than chains");
   m_poolSize = mltBootstrapPaths(settings);
   m_report.chains = m_chains;
   m_report.dims = m_dims;
