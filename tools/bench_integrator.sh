@@ -8,7 +8,12 @@
 # the bootstrap excluded), relMSE x seconds (lower is better: the error at equal time for an error
 # falling as 1 / time), relMSE x spp (the error per sample, throughput aside; an mlt render's spp
 # counts mutations per chain), and the ratio
-# path / integrator of the medians' relMSE x s (> 1: the integrator wins). The reference's own
+# path / integrator of the medians' relMSE x s (> 1: the integrator wins); then the means of
+# relMSE x s over the seeds with their standard errors and the ratio of the means. The error of a
+# Metropolis render is heavy-tailed (a chain that starts at a rare bright path can put half of a
+# region's error into a few pixels: docs/mlt.md, "The pool's size"), so the median of a few seeds
+# moves a lot between runs; the mean estimates the expected error, which equal-time efficiency
+# is about, and its standard error says how far to trust it. The reference's own
 # noise adds the same amount to both relMSEs (give REF_SPP ~10x what a run reaches).
 # A scene written SCENE@x0,y0,x1,y1 is also measured in that region of its image (fractions of the
 # width and height from the top left, `nusselt diff --region`): its relMSE, relMSE x s and ratio
@@ -101,6 +106,15 @@ for entry in $scenes; do
     printf "%-14s path / %s (relMSE x s): %.3f\n" "$name" "$mode" \
       "$(calc "$(cat "$dir/$name.path.median") / $(cat "$dir/$name.$mode.median")")"
   done
+  for mode in "${modes[@]}"; do
+    read -r m se < <(awk '{print $3}' "$dir/$name.$mode" | mean_se)
+    printf "%-14s %-5s mean relMSE x s %.5g +- %.2g (%d seeds)\n" "$name" "$mode" "$m" "$se" "$(wc -l < "$dir/$name.$mode")"
+    echo "$m" > "$dir/$name.$mode.mean"
+  done
+  for mode in "${modes[@]:1}"; do
+    printf "%-14s path / %s (mean relMSE x s): %.3f\n" "$name" "$mode" \
+      "$(calc "$(cat "$dir/$name.path.mean") / $(cat "$dir/$name.$mode.mean")")"
+  done
   if [ -n "$region" ]; then
     for mode in "${modes[@]}"; do
       printf "%-14s %-5s region %s median: relMSE %.5g  relMSE x s %.5g\n" "$name" "$mode" "$region" \
@@ -110,6 +124,15 @@ for entry in $scenes; do
     for mode in "${modes[@]:1}"; do
       printf "%-14s region %s path / %s (relMSE x s): %.3f\n" "$name" "$region" "$mode" \
         "$(calc "$(cat "$dir/$name.path.region.median") / $(cat "$dir/$name.$mode.region.median")")"
+    done
+    for mode in "${modes[@]}"; do
+      read -r m se < <(awk '{print $2}' "$dir/$name.$mode.region" | mean_se)
+      printf "%-14s %-5s region %s mean relMSE x s %.5g +- %.2g\n" "$name" "$mode" "$region" "$m" "$se"
+      echo "$m" > "$dir/$name.$mode.region.mean"
+    done
+    for mode in "${modes[@]:1}"; do
+      printf "%-14s region %s path / %s (mean relMSE x s): %.3f\n" "$name" "$region" "$mode" \
+        "$(calc "$(cat "$dir/$name.path.region.mean") / $(cat "$dir/$name.$mode.region.mean")")"
     done
   fi
 done

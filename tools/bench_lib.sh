@@ -8,6 +8,9 @@ calc() { awk "BEGIN { print $* }"; }
 
 # The median of the numbers on stdin, one per line.
 median() { sort -g | awk '{v[NR] = $1} END {if (NR % 2) print v[(NR + 1) / 2]; else print (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
+# The mean of a column of numbers and its standard error (sample standard deviation / sqrt(n); 0
+# for one number): "MEAN SE".
+mean_se() { awk '{s += $1; q += $1 * $1; n++} END {m = s / n; v = n > 1 ? (q - n * m * m) / (n - 1) : 0; if (v < 0) v = 0; printf "%.6g %.6g\n", m, sqrt(v / n)}'; }
 
 # A scene's short name: its file name without .gltf/.glb ("default": the built-in Cornell box).
 scene_name() { basename "${1%.gltf}" .glb; }
