@@ -864,7 +864,7 @@ int runCli(int argc, char** argv) {
   render->add_option("--mlt-chains", ra.mltChains, "mlt: Markov chains in flight (each a path per mutation)")
       ->capture_default_str()->check(CLI::Range(64u, 4194240u));
   render->add_option("--mlt-bootstrap", ra.mltBootstrap, "mlt: independent bootstrap paths for the normalisation and "
-                                                         "the chains' starts (0: 16 x chains, at least 2^20)")
+                                                         "the chains' starts (0: 16 x chains, at least 2^21)")
       ->capture_default_str();
   render->add_option("--mlt-large-step", ra.mltLargeStep, "mlt: probability of a large step (an independent path)")
       ->capture_default_str()->check(CLI::Range(0.0f, 1.0f));

@@ -21,8 +21,8 @@ Scene cornell() { return test::defaultScene(); }
 RenderSettings base(std::uint32_t seed) { return test::integratorSettings(seed); }
 
 // The Cornell box has no delta lobe, hence no caustic light: its tests put indirect light in the
-// chains (or all of it: mltPassSpp 0), one step per iteration and the anchors' large-step
-// probability, as they were measured with.
+// chains (or all of it: mltPassSpp 0), one step per iteration, the anchors' large-step
+// probability and a pool of 2^20, as they were measured with.
 RenderSettings mltSettings(std::uint32_t seed, std::uint32_t chains, std::uint32_t iterations) {
   RenderSettings s = base(seed);
   s.integrator = IntegratorKind::Mlt;
@@ -31,6 +31,7 @@ RenderSettings mltSettings(std::uint32_t seed, std::uint32_t chains, std::uint32
   s.mltChainLight = RADIANCE_INDIRECT;
   s.mltSteps = 1;
   s.mltLargeStep = 0.3f;
+  s.mltBootstrap = 1u << 20;
   return s;
 }
 
