@@ -55,6 +55,22 @@ attr() { exr_attr "$bin" "$1" "$2"; }
 echo "bench_integrator: $integrator against path, ${size}x${size}, --time $budget per run, reference $refSpp spp (path)," \
      "max depth $depth, $repeats repeats, $integrator with: ${ARGS:-(defaults)}${ARGS2:+; $integrator-2 with: $ARGS2}${ARGS3:+; $integrator-3 with: $ARGS3}"
 echo "device: $("$bin" devices | head -1)"
+# The mean of column `col` of every mode's runs ($dir/$name.$mode$suffix: relMSE x s) with its
+# standard error, then path / mode of the means; `label` follows the mode ("" or "region R ").
+print_means() {
+  local suffix=$1 col=$2 label=$3 mode m se
+  for mode in "${modes[@]}"; do
+    read -r m se < <(awk -v c="$col" '{print $c}' "$dir/$name.$mode$suffix" | mean_se)
+    printf "%-14s %-5s %smean relMSE x s %.5g +- %.2g (%d seeds)\n" "$name" "$mode" "$label" "$m" "$se" \
+      "$(wc -l < "$dir/$name.$mode$suffix")"
+    echo "$m" > "$dir/$name.$mode$suffix.mean"
+  done
+  for mode in "${modes[@]:1}"; do
+    printf "%-14s %spath / %s (mean relMSE x s): %.3f\n" "$name" "$label" "$mode" \
+      "$(calc "$(cat "$dir/$name.path$suffix.mean") / $(cat "$dir/$name.$mode$suffix.mean")")"
+  done
+}
+
 for entry in $scenes; do
   scene=${entry%%@*}
   region=""
@@ -106,15 +122,7 @@ for entry in $scenes; do
     printf "%-14s path / %s (relMSE x s): %.3f\n" "$name" "$mode" \
       "$(calc "$(cat "$dir/$name.path.median") / $(cat "$dir/$name.$mode.median")")"
   done
-  for mode in "${modes[@]}"; do
-    read -r m se < <(awk '{print $3}' "$dir/$name.$mode" | mean_se)
-    printf "%-14s %-5s mean relMSE x s %.5g +- %.2g (%d seeds)\n" "$name" "$mode" "$m" "$se" "$(wc -l < "$dir/$name.$mode")"
-    echo "$m" > "$dir/$name.$mode.mean"
-  done
-  for mode in "${modes[@]:1}"; do
-    printf "%-14s path / %s (mean relMSE x s): %.3f\n" "$name" "$mode" \
-      "$(calc "$(cat "$dir/$name.path.mean") / $(cat "$dir/$name.$mode.mean")")"
-  done
+  print_means "" 3 ""
   if [ -n "$region" ]; then
     for mode in "${modes[@]}"; do
       printf "%-14s %-5s region %s median: relMSE %.5g  relMSE x s %.5g\n" "$name" "$mode" "$region" \
@@ -125,14 +133,6 @@ for entry in $scenes; do
       printf "%-14s region %s path / %s (relMSE x s): %.3f\n" "$name" "$region" "$mode" \
         "$(calc "$(cat "$dir/$name.path.region.median") / $(cat "$dir/$name.$mode.region.median")")"
     done
-    for mode in "${modes[@]}"; do
-      read -r m se < <(awk '{print $2}' "$dir/$name.$mode.region" | mean_se)
-      printf "%-14s %-5s region %s mean relMSE x s %.5g +- %.2g\n" "$name" "$mode" "$region" "$m" "$se"
-      echo "$m" > "$dir/$name.$mode.region.mean"
-    done
-    for mode in "${modes[@]:1}"; do
-      printf "%-14s region %s path / %s (mean relMSE x s): %.3f\n" "$name" "$region" "$mode" \
-        "$(calc "$(cat "$dir/$name.path.region.mean") / $(cat "$dir/$name.$mode.region.mean")")"
-    done
+    print_means .region 2 "region $region "
   fi
 done
