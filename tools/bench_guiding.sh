@@ -18,7 +18,11 @@
 #   default Cornell box, "default"),
 #   GUIDE_ARGS (extra options of the guided renders, e.g. "--guide-spatial 1000"),
 #   VARIANTS (guided variants' own options, separated by "|", each added to GUIDE_ARGS; default
-#   one variant without options, e.g. "--guide-alpha auto|--guide-alpha 0.5").
+#   one variant without options, e.g. "--guide-alpha auto|--guide-alpha 0.5"; a variant that
+#   starts with "@PATH " runs the binary PATH instead of NUSSELT, e.g. a copy of the previous
+#   main's: "|@/tmp/nusselt-old" compares the two interleaved).
+# Besides the medians, the means of relMSE over the seeds with their standard errors (the error
+# of a guided render is heavy-tailed: a few paths through a poorly learned cell).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=${1:-/tmp/nusselt-bench-guiding}
@@ -46,7 +50,18 @@ modes=(off)
 for ((v = 0; v < ${#variants[@]}; v++)); do modes+=("on$v"); done
 if [ -n "$budget" ]; then per="$budget s of rendering per run (at most $spp spp)"; else per="$spp spp per run"; fi
 echo "bench_guiding: ${size}x${size}, $per, reference $refSpp spp (unguided), max depth $depth, $repeats repeats, guided with: --guiding on ${GUIDE_ARGS:-}"
-for ((v = 0; v < ${#variants[@]}; v++)); do echo "  variant on$v: ${variants[$v]}"; done
+# A variant's binary ("@PATH " before its options) and its options.
+variant_bin() { local v=${variants[$1]}; if [[ $v == @* ]]; then v=${v%% *}; echo "${v#@}"; else echo "$bin"; fi; }
+variant_args() {
+  local v=${variants[$1]}
+  if [[ $v != @* ]]; then echo "$v"; elif [[ $v == *" "* ]]; then echo "${v#* }"; fi
+  return 0
+}
+for ((v = 0; v < ${#variants[@]}; v++)); do
+  vb=$(variant_bin $v)
+  [ -x "$vb" ] || { echo "variant on$v: no binary $vb" >&2; exit 2; }
+  echo "  variant on$v: $(variant_args $v)$([ "$vb" != "$bin" ] && echo " (binary $vb)")"
+done
 echo "load average at the start: $(cut -d' ' -f1-3 /proc/loadavg)"
 echo "device: $("$bin" devices | head -1)"
 for scene in $scenes; do
@@ -61,9 +76,13 @@ for scene in $scenes; do
   # time, and with TIME in its budget (a cold cache once left a guided run 1 spp).
   for mode in "${modes[@]}"; do
     extra="--guiding off"
-    [ "$mode" != off ] && extra="--guiding on ${GUIDE_ARGS:-} ${variants[${mode#on}]}"
+    run=$bin
+    if [ "$mode" != off ]; then
+      extra="--guiding on ${GUIDE_ARGS:-} $(variant_args "${mode#on}")"
+      run=$(variant_bin "${mode#on}")
+    fi
     # shellcheck disable=SC2086
-    "$bin" render $sceneArg $common --width 16 --height 16 --spp 2 --guide-train 1 $extra -o "$dir/warm-up.exr"
+    "$run" render $sceneArg $common --width 16 --height 16 --spp 2 --guide-train 1 $extra -o "$dir/warm-up.exr"
   done
   for ((r = 1; r <= repeats; r++)); do
     for mode in "${modes[@]}"; do
@@ -71,12 +90,14 @@ for scene in $scenes; do
       t0=$(date +%s.%N)
       guiding=off
       extra=""
+      run=$bin
       if [ "$mode" != off ]; then
         guiding=on
-        extra="${GUIDE_ARGS:-} ${variants[${mode#on}]}"
+        extra="${GUIDE_ARGS:-} $(variant_args "${mode#on}")"
+        run=$(variant_bin "${mode#on}")
       fi
       # shellcheck disable=SC2086
-      "$bin" render $sceneArg $common --spp "$spp" ${budget:+--time "$budget"} --seed "$r" --guiding "$guiding" $extra -o "$out"
+      "$run" render $sceneArg $common --spp "$spp" ${budget:+--time "$budget"} --seed "$r" --guiding "$guiding" $extra -o "$out"
       t1=$(date +%s.%N)
       sec=$(echo "$t1 - $t0" | bc -l)
       rel=$("$bin" diff "$out" "$ref" | awk '{print $2}')
@@ -93,13 +114,17 @@ for scene in $scenes; do
     mp=$(awk '{print $3}' "$dir/$name.$mode" | median)
     mg=$(awk '{print $4}' "$dir/$name.$mode" | median)
     printf "%-20s guiding %-3s median: relMSE %.5g  %.2f s  relMSE x s %.5g  %s spp\n" "$name" "$mode" "$mr" "$ms" "$mp" "$mg"
+    read -r mm se < <(awk '{print $1}' "$dir/$name.$mode" | mean_se)
+    printf "%-20s guiding %-3s mean:   relMSE %.5g +- %.2g\n" "$name" "$mode" "$mm" "$se"
+    eval "m_$mode=$mm"
     eval "p_$mode=$mp"
     eval "r_$mode=$mr"
   done
   for mode in "${modes[@]:1}"; do
     rOn=r_$mode
     pOn=p_$mode
-    printf "%-20s unguided / guided %s: relMSE %.3fx, relMSE x time %.3fx (> 1: guiding wins)\n" "$name" "$mode" \
-      "$(calc "$r_off / ${!rOn}")" "$(calc "$p_off / ${!pOn}")"
+    mOn=m_$mode
+    printf "%-20s unguided / guided %s: relMSE %.3fx, relMSE x time %.3fx, means %.3fx (> 1: guiding wins)\n" "$name" "$mode" \
+      "$(calc "$r_off / ${!rOn}")" "$(calc "$p_off / ${!pOn}")" "$(calc "$m_off / ${!mOn}")"
   done
 done

@@ -605,6 +605,13 @@ void continuePath(PathStep s, uint path, uint bounce, uint roulette, vec3 x, vec
   beta *= s.factor;
   if (roulette != ROULETTE_ALBEDO) {
     if (transmitted) etaScale *= s.etaScale;
+    // A guided sample's weight is f cos / p_mix, smaller than BSDF sampling's f cos / p_bsdf where
+    // the guide expects more light: the throughput roulette would end most of the samples the
+    // guide sends towards bright light. So the roulette's scale gains p_mix / p_bsdf where that
+    // is above 1 (never below: the roulette never ends more than it would unguided; with the
+    // ratio itself its factors below 1 compound over bounces into rare heavy survivors).
+    // docs/guiding.md, "Russian roulette".
+    if (GUIDING && s.selection.z > 0.0f && s.selection.y > 0.0f) etaScale *= max(1.0f, s.pdf / s.selection.y);
     if (!throughputRoulette(bounce, beta, etaScale, uR)) return;
   }
   if (GUIDING && !guidePhotons())
