@@ -23,8 +23,8 @@ std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t slots,
 }
 
 std::uint32_t MltIntegrator::pathSlotsFor(const RenderSettings& s, std::uint64_t pixels) {
-  if (!s.mltPassSpp) return s.mltChains;
-  return static_cast<std::uint32_t>(std::max<std::uint64_t>(s.mltChains, std::min<std::uint64_t>(pixels * s.mltPassSpp, 1u << 16)));
+  const std::uint64_t wanted = std::max<std::uint64_t>(pixels * s.mltPassSpp, mltBootstrapPaths(s));
+  return static_cast<std::uint32_t>(std::max<std::uint64_t>(s.mltChains, std::min<std::uint64_t>(wanted, 1u << 16)));
 }
 
 std::uint32_t MltIntegrator::iterationsPerPassFor(const RenderSettings& s) {
