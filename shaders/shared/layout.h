@@ -485,7 +485,7 @@ struct Globals {
   BUFREF(Vec4s) pathDirection; // per path: ray direction, w = pdf of the BSDF sample (0: delta/camera)
   BUFREF(Vec4s) pathThroughput;// per path: throughput (rgb), w = etaScale (the product of (n_t / n_i)^2 over
                                // refractions, which undoes their radiance scaling for the roulette;
-                               // guided renders: also of p_mix / p_bsdf over guided bounces)
+                               // guided renders: also of max(1, p_mix / p_bsdf) over guided bounces)
   BUFREF(Vec4s) pathRadiance;  // per path: radiance gathered so far (rgb)
   BUFREF(UVec4s) pathInfo;     // per path: (pixel, sample index, bounces shaded (PRIMARY_SAMPLES stages only), 0)
   BUFREF(Vec4s) pathHit;       // per path: (t, b1, b2, triangle bits)
