@@ -57,6 +57,17 @@ variant_args() {
   if [[ $v != @* ]]; then echo "$v"; elif [[ $v == *" "* ]]; then echo "${v#* }"; fi
   return 0
 }
+# A mode's binary, --guiding value and guided options: sets run, guiding and extra.
+mode_setup() {
+  run=$bin
+  guiding=off
+  extra=""
+  if [ "$1" != off ]; then
+    run=$(variant_bin "${1#on}")
+    guiding=on
+    extra="${GUIDE_ARGS:-} $(variant_args "${1#on}")"
+  fi
+}
 for ((v = 0; v < ${#variants[@]}; v++)); do
   vb=$(variant_bin $v)
   [ -x "$vb" ] || { echo "variant on$v: no binary $vb" >&2; exit 2; }
@@ -75,27 +86,15 @@ for scene in $scenes; do
   # disk cache keeps it for later processes), which would otherwise land in the first round's
   # time, and with TIME in its budget (a cold cache once left a guided run 1 spp).
   for mode in "${modes[@]}"; do
-    extra="--guiding off"
-    run=$bin
-    if [ "$mode" != off ]; then
-      extra="--guiding on ${GUIDE_ARGS:-} $(variant_args "${mode#on}")"
-      run=$(variant_bin "${mode#on}")
-    fi
+    mode_setup "$mode"
     # shellcheck disable=SC2086
-    "$run" render $sceneArg $common --width 16 --height 16 --spp 2 --guide-train 1 $extra -o "$dir/warm-up.exr"
+    "$run" render $sceneArg $common --width 16 --height 16 --spp 2 --guide-train 1 --guiding "$guiding" $extra -o "$dir/warm-up.exr"
   done
   for ((r = 1; r <= repeats; r++)); do
     for mode in "${modes[@]}"; do
       out="$dir/$name-$mode-$r.exr"
       t0=$(date +%s.%N)
-      guiding=off
-      extra=""
-      run=$bin
-      if [ "$mode" != off ]; then
-        guiding=on
-        extra="${GUIDE_ARGS:-} $(variant_args "${mode#on}")"
-        run=$(variant_bin "${mode#on}")
-      fi
+      mode_setup "$mode"
       # shellcheck disable=SC2086
       "$run" render $sceneArg $common --spp "$spp" ${budget:+--time "$budget"} --seed "$r" --guiding "$guiding" $extra -o "$out"
       t1=$(date +%s.%N)
