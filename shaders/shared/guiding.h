@@ -60,13 +60,27 @@ SHARED_FN vec3 guideSquareToDirection(vec2 p) {
 
 // ---- Space ----------------------------------------------------------------------------------------
 
-// info of the spatial leaf whose box holds x (guiding_layout.h: (GUIDE_SPATIAL_LEAF, root,
-// alpha bits, 0)). Points outside the root box go to the nearest leaf along each split. A tree
+// The orientation class (guiding_layout.h, GUIDE_ORIENTATIONS) of a vertex whose geometric normal,
+// on the side the path is on, is n: 2 x the axis of its largest component (the first of equal
+// ones) + 1 if that component is negative.
+SHARED_FN uint guideOrientation(vec3 n) {
+  vec3 a = abs(n);
+  uint axis = a.x >= a.y && a.x >= a.z ? 0u : (a.y >= a.z ? 1u : 2u);
+  float c = axis == 0u ? n.x : (axis == 1u ? n.y : n.z);
+  return 2u * axis + (c < 0.0f ? 1u : 0u);
+}
+
+// The spatial root of orientation class o in a tree of `roots` roots (GpuGuide.info.z).
+SHARED_FN uint guideSpatialRoot(uint roots, uint o) { return roots > 1u ? min(o, roots - 1u) : 0u; }
+
+// info of the spatial leaf whose box holds x, under the root of orientation class o
+// (guiding_layout.h: (GUIDE_SPATIAL_LEAF, root, alpha bits, 0)). Points outside the root box go
+// to the nearest leaf along each split. A tree
 // deeper than the loop bound (never built) gives an unguided region (alpha 0). Each inner node
 // holds its split coordinate (the midpoint of its box, as GuideTree::findNode computes it): the
 // descent keeps no box and indexes no array by a variable.
-SHARED_FN uvec4 guideLeafInfo(GuideView G, vec3 x) {
-  uint node = 0u;
+SHARED_FN uvec4 guideLeafInfo(GuideView G, vec3 x, uint o) {
+  uint node = guideSpatialRoot(GUIDE_VIEW_INFO(G).info.z, o);
   for (uint d = 0u; d < GUIDE_MAX_SPATIAL_DEPTH; ++d) {
     uvec4 info = GUIDE_SPATIAL(G, node).info;
     if (info.x == GUIDE_SPATIAL_LEAF) return info;
@@ -165,8 +179,9 @@ struct GuideVertex {
 };
 
 #if NUSSELT_SCENE_FEATURES
-GuideVertex guideVertex(vec3 x) {
-  uvec4 info = guideLeafInfo(g.guide.v[0], x);
+// The region of a vertex at x whose geometric normal on the path's side is ng.
+GuideVertex guideVertex(vec3 x, vec3 ng) {
+  uvec4 info = guideLeafInfo(g.guide.v[0], x, guideOrientation(ng));
   GuideVertex v;
   v.root = info.y;
   v.alpha = uintBitsToFloat(info.z);
@@ -199,16 +214,16 @@ bool guideRecording() { return g.guide.v[0].info.x > 0u; }
 // gather emission nor sample lights, the escape stage does nothing.
 bool guidePhotons() { return g.guide.v[0].info.y != 0u; }
 
-// Photon record k = bounce of this photon (guiding_layout.h, "Photon records"): it arrived at x
-// from the world direction wFrom (unit, towards where it came from) carrying power of luminance
-// value (> 0).
-void guideRecordPhoton(uint path, uint bounce, vec3 x, vec3 wFrom, float value) {
+// Photon record k = bounce of this photon (guiding_layout.h, "Photon records"): it arrived at x,
+// on the side of the surface whose geometric normal is ng, from the world direction wFrom (unit,
+// towards where it came from) carrying power of luminance value (> 0).
+void guideRecordPhoton(uint path, uint bounce, vec3 x, vec3 ng, vec3 wFrom, float value) {
   uint n = g.guide.v[0].info.x;
   if (bounce >= n) return;
   GuideRecords R = g.guide.v[0].records;
   uint i = guideRecordIndex(path, bounce, g.chunkPaths);
   storeVec4(R, i, vec4(x, value));
-  storeVec4(R, i + 1u, vec4(wFrom, 1.0f));
+  storeVec4(R, i + 1u, vec4(wFrom, 1.0f + float(guideOrientation(ng))));
 }
 
 // A camera path's first record reads "ended at vertex 0" until a stage writes its arrival there
@@ -233,18 +248,19 @@ void guideRecordArrival(uint path, uint bounce, vec3 x) {
   storeVec4(R, i + 1u, vec4(0.0f));
 }
 
-// The path goes on from vertex `bounce` in the world direction wi; value = luminance of the new
-// throughput x the sample's density per steradian, or -1 (a delta sample: not splatted);
-// selection = (guide density, BRDF-sampler density, alpha) of the sample (guiding_layout.h, c).
+// The path goes on from vertex `bounce` (geometric normal ng on the path's side) in the world
+// direction wi; value = luminance of the new throughput x the sample's density per steradian, or
+// -1 (a delta sample: not splatted); selection = (guide density, BRDF-sampler density, alpha) of
+// the sample (guiding_layout.h, c).
 // The next record reads "nothing arrived (-1), ended there" until a stage writes its arrival (a
 // ray that leaves a scene without environment, or a path the next bounce ends, never gets one).
-void guideRecordSample(uint path, uint bounce, vec3 wi, float value, vec3 selection) {
+void guideRecordSample(uint path, uint bounce, vec3 ng, vec3 wi, float value, vec3 selection) {
   uint n = g.guide.v[0].info.x;
   if (bounce >= n) return;
   GuideRecords R = g.guide.v[0].records;
   uint i = guideRecordIndex(path, bounce, g.chunkPaths);
   storeVec4(R, i + 1u, vec4(wi, value > 0.0f ? value : -1.0f));  // 0 would read as "ended here"
-  storeVec4(R, i + 2u, vec4(selection, 0.0f));
+  storeVec4(R, i + 2u, vec4(selection, float(guideOrientation(ng))));
   if (bounce + 1u < n) {
     uint j = guideRecordIndex(path, bounce + 1u, g.chunkPaths);
     storeVec4(R, j, vec4(0.0f, 0.0f, 0.0f, -1.0f));
@@ -253,15 +269,15 @@ void guideRecordSample(uint path, uint bounce, vec3 wi, float value, vec3 select
 }
 #else
 // A module without guiding (NUSSELT_SCENE_FEATURES 0, stage_common.glsl): empty stand-ins.
-GuideVertex guideVertex(vec3 x) { return GuideVertex(0u, 0.0f); }
+GuideVertex guideVertex(vec3 x, vec3 ng) { return GuideVertex(0u, 0.0f); }
 float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) { return pdfBsdf; }
 float guideDescend(GuideVertex v, bool guided, float uDescent, PathKey k, uint bounce, inout vec3 w) { return 0.0f; }
 bool guideRecording() { return false; }
 bool guidePhotons() { return false; }
-void guideRecordPhoton(uint path, uint bounce, vec3 x, vec3 wFrom, float value) {}
+void guideRecordPhoton(uint path, uint bounce, vec3 x, vec3 ng, vec3 wFrom, float value) {}
 void guideRecordArrival(uint path, uint bounce, vec3 x) {}
 void guideRecordStart(uint path) {}
-void guideRecordSample(uint path, uint bounce, vec3 wi, float value, vec3 selection) {}
+void guideRecordSample(uint path, uint bounce, vec3 ng, vec3 wi, float value, vec3 selection) {}
 #endif
 #endif
 

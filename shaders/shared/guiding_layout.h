@@ -14,6 +14,13 @@
 #include "prelude.h"
 SHARED_BEGIN
 
+// Orientation classes of a vertex (guideOrientation: the axis and sign of the largest component of
+// its geometric normal, on the side the path is on: +x, -x, +y, -y, +z, -z). With info.z =
+// GUIDE_ORIENTATIONS the spatial tree has one root per class (nodes 0 .. 5, each over the whole
+// box): a region holds surfaces of one orientation, so its guide learns one hemisphere's light
+// and sends no samples below its surfaces (docs/guiding.md, "Regions by orientation").
+#define GUIDE_ORIENTATIONS 6u
+
 // Spatial node kinds: 0, 1, 2 = inner node split along x, y, z; this value = leaf.
 #define GUIDE_SPATIAL_LEAF 3u
 // Loop bounds of the descents (lavapipe truncates loops silently: every loop is bounded). The
@@ -66,7 +73,8 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer GuideRecord
 //        from a vertex whose sample is not splatted (a delta lobe));
 //   c = (the guide's density per steradian at the sampled direction (-1: the vertex does not
 //        sample the mixture, a combined material), the BRDF sampler's density there, the
-//        selection probability alpha the sample was drawn with, 0); read only when b.w > 0.
+//        selection probability alpha the sample was drawn with, the vertex's orientation class
+//        (guideOrientation)); read only when b.w > 0.
 // The radiance that reached vertex k from its sampled direction is then (path radiance at the
 // end - a.w of record k + 1) / (luminance of the throughput), and the splat is that divided by
 // the density (src/guiding/guide_tree.cpp, splatPaths); c lets the trainer estimate, per region,
@@ -76,12 +84,14 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer GuideRecord
 // record k of photon p, written by the shade stage where the photon's ray of bounce k arrived
 // (k >= 1: after at least one bounce off a surface, indirect light; k = 0, direct light, is NEE's):
 //   a = (position (xyz), luminance of the photon's power on arrival);
-//   b = (unit world direction towards where it came from, 1); b.w = 0: no record.
+//   b = (unit world direction towards where it came from, 1 + the orientation class of the
+//        surface on the side it arrived from); b.w = 0: no record.
 #define GUIDE_RECORD_VEC4S 3u
 // The first vec4 of record k of path p (chunk-local) in a chunk of `paths` paths.
 SHARED_FN uint guideRecordIndex(uint path, uint k, uint paths) { return (k * paths + path) * GUIDE_RECORD_VEC4S; }
 // boundsMin, boundsMax: the spatial tree's root box (w unused);
-// info = (records per path, 0: not recording; 1: the photon pre-pass, else 0; 0, 0).
+// info = (records per path, 0: not recording; 1: the photon pre-pass, else 0; spatial roots:
+//         GUIDE_ORIENTATIONS (one per orientation class) or 1 (every vertex at node 0); 0).
 struct GpuGuide {
   vec4 boundsMin;
   vec4 boundsMax;

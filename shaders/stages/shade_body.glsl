@@ -248,8 +248,9 @@ struct ShadeMaterial {
 // seen from the inside (transmissionInsideParams: eta -> 1 / eta) and their sampler tables
 // (GpuMaterial.components.z), as the smooth dielectric takes 1 / eta there (dielectric.h).
 // The guide is off for transmitting models (alpha = 0): its mixture covers the upper hemisphere only.
+// x, ng: the hit point and its geometric normal on the path's side (the guide's region, guideVertex).
 // hit: unused (evalParams textured M's parameters before).
-ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, ShadeHit hit, bool inside) {
+ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 ng, vec3 wo, uint roulette, ShadeHit hit, bool inside) {
   ShadeMaterial m;
   m.M = M;
   if (modelTransmits(MODEL_ID) && inside) {
@@ -257,7 +258,7 @@ ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, Shade
     m.M.info.z = M.components.z;
   }
   m.gv = GuideVertex(0u, 0.0f);
-  if (GUIDING && !modelIsDelta(MODEL_ID) && !modelTransmits(MODEL_ID)) m.gv = guideVertex(x);
+  if (GUIDING && !modelIsDelta(MODEL_ID) && !modelTransmits(MODEL_ID)) m.gv = guideVertex(x, ng);
 #if NUSSELT_BINNED
   m.binned = HAS_BINS && MODEL_ID == MODEL_GLTF_PBR && (M.info.y & MATERIAL_BINNED) != 0u;
 #endif
@@ -379,7 +380,7 @@ bool componentTransmits(uint model) { return modelTransmits(model) && !modelIsDe
 // base colour and metallic-roughness, the transmitting models' tint), and the transmission
 // texture's R (transmissionAt) sets the weights below. inside: the path arrived from the inside
 // (insideComponent).
-ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 wo, uint roulette, ShadeHit hit, bool inside) {
+ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 ng, vec3 wo, uint roulette, ShadeHit hit, bool inside) {
   ShadeMaterial m;
   m.a = vec4(0.0f);
   uint first = M.components.x;
@@ -615,7 +616,7 @@ void continuePath(PathStep s, uint path, uint bounce, uint roulette, vec3 x, vec
     if (!throughputRoulette(bounce, beta, etaScale, uR)) return;
   }
   if (GUIDING && !guidePhotons())
-    guideRecordSample(path, bounce, wi, s.delta ? -1.0f : luminance(beta) * s.pdf, s.selection);
+    guideRecordSample(path, bounce, ng, wi, s.delta ? -1.0f : luminance(beta) * s.pdf, s.selection);
   storeVec4(g.pathOrigin, path, vec4(xo, causticState));
   storeVec4(g.pathDirection, path, vec4(wi, s.pdf));
   storeVec4(g.pathThroughput, path, vec4(beta, etaScale));
@@ -664,6 +665,7 @@ void main() {
   bool photon = GUIDING && guidePhotons();
   if (GUIDING && !photon) guideRecordArrival(path, bounce, x);  // training record (guiding.h)
   bool frontFace = dot(ngFront, dir) < 0.0f;
+  vec3 ng = frontFace ? ngFront : -ngFront;  // the geometric normal on the side the ray came from
 
   // ---- Beer-Lambert: a ray that meets an absorbing material from the back came from inside ----
   // (shared/volume.h; docs/scenes.md, "Volumes"): the segment of length hit.x (dir is a unit
@@ -673,7 +675,7 @@ void main() {
   // training record: where, from where, the luminance of its power.
   if (photon && bounce >= 1u) {
     float power = luminance(beta) * g.pathRadiance.v[path].w;
-    if (power > 0.0f && isFinite(power)) guideRecordPhoton(path, bounce, x, -dir, power);
+    if (power > 0.0f && isFinite(power)) guideRecordPhoton(path, bounce, x, ng, -dir, power);
   }
 
   // Caustic light (RADIANCE_CAUSTIC, NONCAUSTIC; layout.h): the path's state in pathOrigin.w (0: no
@@ -700,7 +702,6 @@ void main() {
   }
 
   // ---- Local frame: surfaces are two-sided, shade the side the ray came from ----
-  vec3 ng = frontFace ? ngFront : -ngFront;
   if (dot(ns, ng) < 0.0f) ns = -ns;
   vec3 wWorld = -dir;
   vec3 tt;
@@ -718,7 +719,7 @@ void main() {
   bool last = bounce >= g.maxDepth || (part == RADIANCE_DIRECT && bounce >= 1u) ||
               (part == RADIANCE_CAUSTIC && causticState == 2.0f);
 
-  ShadeMaterial m = shadeMaterial(M, x, wo, roulette, ShadeHit(S.info.x, tri, hit.y, hit.z), !frontFace);
+  ShadeMaterial m = shadeMaterial(M, x, ng, wo, roulette, ShadeHit(S.info.x, tri, hit.y, hit.z), !frontFace);
   if (!last && !photon && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m) && radiancePartKeeps(part, bounce + 1u, false))
     nextEvent(m, path, key, bounce, lighting, x, xo, ng, tt, bb, ns, wo, beta);
 

@@ -150,6 +150,12 @@ int guideViewCommand(const GuideViewArgs& a) {
     throw Error("--pixel " + std::to_string(px) + " " + std::to_string(py) + ": the ray through its centre meets no "
                 "surface (the guide lives at surfaces)");
   const glm::vec3 x = origin + t * dir;
+  // The hit's geometric normal on the camera's side: its orientation class picks the guide's
+  // spatial root (guideOrientation), as the shade stage does.
+  const glm::vec3 ngFront = glm::normalize(glm::cross(scene.positions[3 * tri + 1] - scene.positions[3 * tri],
+                                                      scene.positions[3 * tri + 2] - scene.positions[3 * tri]));
+  const glm::vec3 ng = glm::dot(ngFront, dir) < 0.0f ? ngFront : -ngFront;
+  const std::uint32_t orientation = shared::guideOrientation(shared::vec3(ng.x, ng.y, ng.z));
   const Material& mat = scene.materials[scene.triangleMaterial[tri]];
 
   vk::Context ctx;
@@ -174,10 +180,11 @@ int guideViewCommand(const GuideViewArgs& a) {
     shared::GuideView view;
     view.g.boundsMin = shared::vec4(tree.boundsMin(), 0.0f);
     view.g.boundsMax = shared::vec4(tree.boundsMax(), 0.0f);
+    view.g.info.z = tree.settings().orientations;
     view.spatial = spatial.data();
     view.dir = dirNodes.data();
-    const shared::uvec4 leafInfo = shared::guideLeafInfo(view, x);
-    const std::uint32_t leaf = tree.findLeaf(x);
+    const shared::uvec4 leafInfo = shared::guideLeafInfo(view, x, orientation);
+    const std::uint32_t leaf = tree.findLeaf(x, orientation);
     const float alpha = glm::uintBitsToFloat(leafInfo.z);
     const std::vector<double> guidePanel =
         panel(a.size, [&](shared::vec2 p) { return double(shared::guideSquarePdf(view, leafInfo.y, p)) / (4.0 * M_PI); });
@@ -191,12 +198,8 @@ int guideViewCommand(const GuideViewArgs& a) {
     else if (spec.delta) brdfNote = "not drawn: " + spec.name + " is a delta model (no density)";
     else if (spec.measured) brdfNote = "not drawn: a measured material";
     else {
-      const glm::vec3 v0 = scene.positions[3 * tri], e1 = scene.positions[3 * tri + 1] - v0,
-                      e2 = scene.positions[3 * tri + 2] - v0;
-      glm::vec3 ngFront = glm::normalize(glm::cross(e1, e2));
       glm::vec3 ns = glm::normalize((1.0f - b1 - b2) * scene.normals[3 * tri] + b1 * scene.normals[3 * tri + 1] +
                                     b2 * scene.normals[3 * tri + 2]);
-      const glm::vec3 ng = glm::dot(ngFront, dir) < 0.0f ? ngFront : -ngFront;
       if (glm::dot(ns, ng) < 0.0f) ns = -ns;
       glm::vec3 tt, bb;
       shared::makeFrame(ns, tt, bb);

@@ -135,18 +135,25 @@ GuideTree::GuideTree(glm::vec3 lo, glm::vec3 hi, const GuideSettings& settings) 
   hi += glm::vec3(pad);
   m_lo = lo;
   m_hi = hi;
-  SpatialNode root;
-  root.lo = lo;
-  root.hi = hi;
-  m_nodes.push_back(root);
-  m_leaves.push_back(Leaf{});
+  // Nodes 0 .. roots - 1: the roots of the orientation classes (guideSpatialRoot), each a leaf.
+  m_settings.orientations = std::clamp<std::uint32_t>(m_settings.orientations, 1u, GUIDE_ORIENTATIONS);
+  for (std::uint32_t o = 0; o < m_settings.orientations; ++o) {
+    SpatialNode root;
+    root.lo = lo;
+    root.hi = hi;
+    root.leaf = o;
+    m_nodes.push_back(root);
+    Leaf leaf;
+    leaf.orientation = o;
+    m_leaves.push_back(leaf);
+  }
 }
 
-std::uint32_t GuideTree::findLeaf(glm::vec3 x) const { return m_nodes[findNode(x)].leaf; }
+std::uint32_t GuideTree::findLeaf(glm::vec3 x, std::uint32_t o) const { return m_nodes[findNode(x, o)].leaf; }
 
-std::uint32_t GuideTree::findNode(glm::vec3 x) const {
+std::uint32_t GuideTree::findNode(glm::vec3 x, std::uint32_t o) const {
   glm::vec3 lo = m_lo, hi = m_hi;
-  std::uint32_t node = 0;
+  std::uint32_t node = shared::guideSpatialRoot(m_settings.orientations, o);
   for (std::uint32_t d = 0; d < GUIDE_MAX_SPATIAL_DEPTH; ++d) {
     const SpatialNode& n = m_nodes[node];
     if (n.axis == GUIDE_SPATIAL_LEAF) return node;
@@ -186,7 +193,7 @@ void GuideTree::splatInLeaf(std::uint32_t leafIndex, glm::vec3 d, double value, 
   if (value > 0 && std::isfinite(value)) splatDirection(leafIndex, d, value);
 }
 
-void GuideTree::splatAt(std::uint32_t leafIndex, glm::vec3 x, glm::vec3 d, double value, double count) {
+void GuideTree::splatAt(std::uint32_t leafIndex, glm::vec3 x, std::uint32_t o, glm::vec3 d, double value, double count) {
   if (splatsStayInTheirLeaf()) {
     splatInLeaf(leafIndex, d, value, count);
     ++m_splats;
@@ -196,7 +203,7 @@ void GuideTree::splatAt(std::uint32_t leafIndex, glm::vec3 x, glm::vec3 d, doubl
   ++m_splats;
   if (!(value > 0) || !std::isfinite(value)) return;
   // The box of x's region's size around x, within the root box.
-  const SpatialNode& home = m_nodes[findNode(x)];
+  const SpatialNode& home = m_nodes[findNode(x, o)];
   const glm::dvec3 half = 0.5 * (glm::dvec3(home.hi) - glm::dvec3(home.lo));
   const glm::dvec3 lo = glm::max(glm::dvec3(x) - half, glm::dvec3(m_lo));
   const glm::dvec3 hi = glm::min(glm::dvec3(x) + half, glm::dvec3(m_hi));
@@ -206,10 +213,11 @@ void GuideTree::splatAt(std::uint32_t leafIndex, glm::vec3 x, glm::vec3 d, doubl
     splatDirection(leafIndex, d, value);
     return;
   }
-  // Every leaf the box overlaps gets the share of its overlapped volume (children in order).
+  // Every leaf of x's orientation class the box overlaps gets the share of its overlapped volume
+  // (children in order).
   std::uint32_t stack[GUIDE_MAX_SPATIAL_DEPTH + 2];
   std::uint32_t top = 0;
-  stack[top++] = 0;
+  stack[top++] = shared::guideSpatialRoot(m_settings.orientations, o);
   while (top > 0) {
     const SpatialNode& n = m_nodes[stack[--top]];
     const glm::dvec3 o = glm::min(hi, glm::dvec3(n.hi)) - glm::max(lo, glm::dvec3(n.lo));
@@ -443,8 +451,9 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
   if (t < 2 || !tree.splatsStayInTheirLeaf() || paths < 4096u) {
     std::uint64_t splats = 0;
     forEachSplat(0, paths, [&](std::uint32_t, std::uint32_t, glm::vec4 a, glm::vec4 b, glm::vec4 c, double after) {
-      const std::uint32_t leaf = tree.findLeaf(glm::vec3(a));
-      tree.splatAt(leaf, glm::vec3(a), glm::vec3(b), after / double(b.w));
+      const std::uint32_t o = std::uint32_t(c.w);
+      const std::uint32_t leaf = tree.findLeaf(glm::vec3(a), o);
+      tree.splatAt(leaf, glm::vec3(a), o, glm::vec3(b), after / double(b.w));
       // The same radiance is the vertex's estimate through its sample (y = F / p_mix).
       if (c.x >= 0.0f) tree.observeSelection(leaf, after, c.x, c.y, c.z);
       ++splats;
@@ -465,8 +474,8 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
   };
   run([&](unsigned i) {
     const std::uint32_t p0 = std::uint32_t(std::uint64_t(paths) * i / t), p1 = std::uint32_t(std::uint64_t(paths) * (i + 1) / t);
-    forEachSplat(p0, p1, [&](std::uint32_t p, std::uint32_t k, glm::vec4 a, glm::vec4, glm::vec4, double) {
-      const std::uint32_t leaf = tree.findLeaf(glm::vec3(a));
+    forEachSplat(p0, p1, [&](std::uint32_t p, std::uint32_t k, glm::vec4 a, glm::vec4, glm::vec4 c, double) {
+      const std::uint32_t leaf = tree.findLeaf(glm::vec3(a), std::uint32_t(c.w));
       leafOf[std::size_t(p) * perPath + k] = leaf;
       ++counts[i][leaf];
     });
@@ -507,8 +516,8 @@ void appendPhotons(const glm::vec4* records, std::uint32_t recordsPerPath, std::
     for (std::uint32_t k = 1; k < recordsPerPath; ++k) {
       const glm::vec4* r = records + shared::guideRecordIndex(p, k, photons);
       const glm::vec4 a = r[0], b = r[1];
-      if (b.w != 1.0f || !(a.w > 0.0f) || !std::isfinite(a.w)) continue;
-      out.push_back({glm::vec3(a), glm::vec3(b), a.w});
+      if (!(b.w >= 1.0f) || !(a.w > 0.0f) || !std::isfinite(a.w)) continue;  // b.w = 1 + orientation
+      out.push_back({glm::vec3(a), std::uint32_t(b.w - 1.0f), glm::vec3(b), a.w});
     }
   }
 }
@@ -517,7 +526,7 @@ std::vector<IterationReport> trainPhotons(GuideTree& tree, const std::vector<Pho
                                           std::uint32_t rounds, double count) {
   std::vector<IterationReport> reports;
   for (std::uint32_t round = 0; round < rounds; ++round) {
-    for (const PhotonSplat& s : splats) tree.splat(s.x, s.d, double(s.value), count);
+    for (const PhotonSplat& s : splats) tree.splat(s.x, s.orientation, s.d, double(s.value), count);
     reports.push_back(tree.endIteration(0));
     reports.back().iteration = round;
     reports.back().photons = true;

@@ -78,6 +78,10 @@ struct GuideSettings {
   // Weight of the uniform sphere density mixed into every trained region's guide (flatten): the
   // density sampled is (1 - floor) x the tree's + floor / (4 pi), so no direction has density 0.
   double floor = 0.0;
+  // Spatial roots: GUIDE_ORIENTATIONS, one tree over the box per orientation class of the
+  // vertices (guideOrientation: a region's surfaces face one way, docs/guiding.md, "Regions by
+  // orientation"), or 1 (every vertex under one root, whatever its normal).
+  std::uint32_t orientations = GUIDE_ORIENTATIONS;
 };
 
 // A quadtree over the map [0, 1)^2; node 0 is the root. energy[c] of a node = the energy of
@@ -162,22 +166,26 @@ struct IterationReport {
 
 class GuideTree {
  public:
-  // The root box: [lo, hi] (the scene's bounds, made non-degenerate).
+  // The root box: [lo, hi] (the scene's bounds, made non-degenerate), one root per orientation
+  // class (settings.orientations).
   GuideTree(glm::vec3 lo, glm::vec3 hi, const GuideSettings& settings);
 
-  // One splat: value (>= 0) = the radiance estimate arriving at x from direction d divided by the
-  // density per steradian with which d was sampled; counts one sample of x's leaf.
+  // One splat: value (>= 0) = the radiance estimate arriving at x, a vertex of orientation class o
+  // (guideOrientation of its normal), from direction d divided by the density per steradian with
+  // which d was sampled; counts one sample of (x, o)'s leaf.
   // With the settings' filters: shared among the regions around x (spatialFilter) and the cells
   // around d (dirFilter); the splat counts of x's own leaf.
   // count: what the splat adds to its leaf's count for the split rule (1; the photon pre-pass's
   // splats count less: trainPhotons).
-  void splat(glm::vec3 x, glm::vec3 d, double value, double count = 1.0) { splatAt(findLeaf(x), x, d, value, count); }
-  // The same for a vertex x known to lie in leaf `leaf` (findLeaf(x)).
-  void splatAt(std::uint32_t leaf, glm::vec3 x, glm::vec3 d, double value, double count = 1.0);
+  void splat(glm::vec3 x, std::uint32_t o, glm::vec3 d, double value, double count = 1.0) {
+    splatAt(findLeaf(x, o), x, o, d, value, count);
+  }
+  // The same for a vertex known to lie in leaf `leaf` (findLeaf(x, o)).
+  void splatAt(std::uint32_t leaf, glm::vec3 x, std::uint32_t o, glm::vec3 d, double value, double count = 1.0);
   // Whether a splat changes nothing outside its own leaf (no spatial filter, or a single leaf):
   // then the splats of different leaves can be applied in parallel (splatPaths), each leaf's in
   // their order, giving the same trees bit for bit.
-  bool splatsStayInTheirLeaf() const { return !m_settings.spatialFilter || m_leaves.size() == 1; }
+  bool splatsStayInTheirLeaf() const { return !m_settings.spatialFilter || m_nodes.size() == m_settings.orientations; }
   // splatAt for a tree whose splats stay in their leaf, touching leaf `leaf` only: the splat is not
   // counted in the iteration's splats (addSplats adds them), so that threads owning different
   // leaves can call it at the same time.
@@ -196,8 +204,9 @@ class GuideTree {
   // Bytes of the flat arrays.
   std::uint64_t bytes() const;
   std::uint32_t leafCount() const { return static_cast<std::uint32_t>(m_leaves.size()); }
-  // The leaf (index into the leaves) whose box holds x: the same float arithmetic as guideLeafInfo.
-  std::uint32_t findLeaf(glm::vec3 x) const;
+  // The leaf (index into the leaves) whose box holds x under the root of orientation class o: the
+  // same float arithmetic as guideLeafInfo.
+  std::uint32_t findLeaf(glm::vec3 x, std::uint32_t o) const;
   const DirTree& samplingTree(std::uint32_t leaf) const { return m_leaves[leaf].sampling; }
   const DirTree& buildingTree(std::uint32_t leaf) const { return m_leaves[leaf].building; }
   double leafSamples(std::uint32_t leaf) const { return m_leaves[leaf].samples; }
@@ -206,6 +215,8 @@ class GuideTree {
   float leafAlpha(std::uint32_t leaf) const { return m_leaves[leaf].alpha; }
   double leafAlphaVertices(std::uint32_t leaf) const { return m_leaves[leaf].alphaVertices; }
   const SelectionStats& leafSelection(std::uint32_t leaf) const { return m_leaves[leaf].selection; }
+  // The orientation class of the leaf's vertices (its root's).
+  std::uint32_t leafOrientation(std::uint32_t leaf) const { return m_leaves[leaf].orientation; }
   // The leaf's box.
   void leafBounds(std::uint32_t leaf, glm::vec3& lo, glm::vec3& hi) const;
   glm::vec3 boundsMin() const { return m_lo; }
@@ -226,12 +237,13 @@ class GuideTree {
     float alpha = 0;  // learned: 0 until the region's guide proves itself
     double alphaVertices = 0;
     SelectionStats selection;
+    std::uint32_t orientation = 0;  // the orientation class whose root it descends from
   };
   void learnAlphas();
   // value into leaf's building tree at direction d (its directional filter if set).
   void splatDirection(std::uint32_t leaf, glm::vec3 d, double value);
-  // The spatial node (a leaf) whose box holds x.
-  std::uint32_t findNode(glm::vec3 x) const;
+  // The spatial node (a leaf) whose box holds x under the root of orientation class o.
+  std::uint32_t findNode(glm::vec3 x, std::uint32_t o) const;
   float leafGuideAlpha(const Leaf& l) const { return m_settings.alpha >= 0 ? m_settings.alpha : l.alpha; }
   std::uint64_t bytesOf(std::size_t spatialNodes, std::uint64_t dirNodes) const;
 
@@ -253,6 +265,7 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
 // The photon pre-pass (docs/guiding.md, "Photon pre-pass"): one photon's arrival after a bounce.
 struct PhotonSplat {
   glm::vec3 x;      // where it arrived
+  std::uint32_t orientation = 0;  // the orientation class of the surface's side it arrived on
   glm::vec3 d;      // unit direction towards where it came from
   float value = 0;  // luminance of its power
 };

@@ -49,7 +49,7 @@ GuideTree trainedTree(std::uint32_t iterations, std::uint32_t maxDirDepth, std::
   for (std::uint32_t it = 0; it < iterations; ++it) {
     for (std::uint32_t i = 0; i < splatsPerIteration; ++i) {
       glm::vec3 d = uniformSphere(rng);
-      t.splat(glm::vec3(0.5f), d, radiance(d) * 4.0 * M_PI);  // radiance / (uniform pdf 1 / 4 pi)
+      t.splat(glm::vec3(0.5f), 0, d, radiance(d) * 4.0 * M_PI);  // radiance / (uniform pdf 1 / 4 pi)
     }
     t.endIteration(it);
   }
@@ -66,6 +66,7 @@ Flat flatten(const GuideTree& t) {
   t.flatten(f.spatial, f.dir);
   f.view.g.boundsMin = shared::vec4(t.boundsMin(), 0.0f);
   f.view.g.boundsMax = shared::vec4(t.boundsMax(), 0.0f);
+  f.view.g.info.z = t.settings().orientations;
   f.view.spatial = f.spatial.data();
   f.view.dir = f.dir.data();
   return f;
@@ -270,33 +271,50 @@ TEST(Guiding, SpatialLeavesSplitAboveCSqrtTwoToTheIteration) {
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> U(0.0f, 1.0f);
     for (int i = 0; i < samples; ++i)
-      t.splat(glm::vec3(4 * U(rng), 2 * U(rng), U(rng)), glm::vec3(0, 0, 1), 1.0);
+      t.splat(glm::vec3(4 * U(rng), 2 * U(rng), U(rng)), 0, glm::vec3(0, 0, 1), 1.0);
     t.endIteration(iteration);
     return t;
   };
+  // The splats are all of orientation class 0; the other classes' roots stay one leaf each.
+  const std::uint32_t others = GUIDE_ORIENTATIONS - 1;
   // 100 splats: not more than 100 sqrt(1): no split.
-  EXPECT_EQ(run(0, 100).leafCount(), 1u);
+  EXPECT_EQ(run(0, 100).leafCount(), 1u + others);
   // 1000 at iteration 0: halves 500, 250, 125, 62.5: four levels of splits, 16 leaves.
   GuideTree a = run(0, 1000);
-  EXPECT_EQ(a.leafCount(), 16u);
+  EXPECT_EQ(a.leafCount(), 16u + others);
   // 1000 at iteration 2 (threshold 200): 500, 250, 125: 8 leaves.
-  EXPECT_EQ(run(2, 1000).leafCount(), 8u);
+  EXPECT_EQ(run(2, 1000).leafCount(), 8u + others);
   // The first split is x = 2 (the midpoint of the longest axis): points either side of it lie in
   // different leaves; the leaf finder of the GPU (guideLeafInfo) agrees with the CPU's.
   Flat f = flatten(a);
   std::mt19937 rng(9);
   std::uniform_real_distribution<float> U(0.0f, 1.0f);
+  // The same for every orientation class: each has its own root, the same point of another class
+  // lies in another leaf (that class's one leaf here).
   for (int i = 0; i < 1000; ++i) {
     glm::vec3 x(4 * U(rng), 2 * U(rng), U(rng));
-    const std::uint32_t leaf = a.findLeaf(x);
-    shared::uvec4 info = shared::guideLeafInfo(f.view, x);
+    const std::uint32_t o = std::uint32_t(i) % GUIDE_ORIENTATIONS;
+    const std::uint32_t leaf = a.findLeaf(x, o);
+    EXPECT_EQ(a.leafOrientation(leaf), o);
+    if (o > 0) EXPECT_EQ(leaf, o);
+    shared::uvec4 info = shared::guideLeafInfo(f.view, x, o);
     EXPECT_EQ(info.x, GUIDE_SPATIAL_LEAF);
     // Leaves are numbered by the flattened roots' order: compare through the leaf's root.
     std::uint32_t root = 0;
     for (std::uint32_t l = 0; l < leaf; ++l) root += std::uint32_t(a.samplingTree(l).nodeCount());
     EXPECT_EQ(info.y, root);
   }
-  EXPECT_NE(a.findLeaf(glm::vec3(1.99f, 1.0f, 0.5f)), a.findLeaf(glm::vec3(2.01f, 1.0f, 0.5f)));
+  EXPECT_NE(a.findLeaf(glm::vec3(1.99f, 1.0f, 0.5f), 0), a.findLeaf(glm::vec3(2.01f, 1.0f, 0.5f), 0));
+  // One root for every class (settings.orientations = 1): the classes share the leaves.
+  s.orientations = 1;
+  GuideTree one = run(0, 1000);
+  EXPECT_EQ(one.leafCount(), 16u);
+  Flat f1 = flatten(one);
+  for (std::uint32_t o = 0; o < GUIDE_ORIENTATIONS; ++o) {
+    const glm::vec3 x(3.0f, 0.5f, 0.25f);
+    EXPECT_EQ(one.findLeaf(x, o), one.findLeaf(x, 0));
+    EXPECT_EQ(shared::guideLeafInfo(f1.view, x, o).y, shared::guideLeafInfo(f1.view, x, 0).y);
+  }
 }
 
 TEST(Guiding, MemoryCapIsEnforcedAndReported) {
@@ -310,7 +328,7 @@ TEST(Guiding, MemoryCapIsEnforcedAndReported) {
   for (std::uint32_t it = 0; it < 4; ++it) {
     for (int i = 0; i < 100000; ++i) {
       glm::vec3 d = uniformSphere(rng);
-      t.splat(glm::vec3(U(rng), U(rng), U(rng)), d, radiance(d));
+      t.splat(glm::vec3(U(rng), U(rng), U(rng)), 0, d, radiance(d));
     }
     IterationReport r = t.endIteration(it);
     EXPECT_LE(r.bytes, s.memoryCap) << "iteration " << it;
@@ -373,7 +391,7 @@ TEST(Guiding, ParallelSplatsGiveTheSameTreesBitForBit) {
   std::uniform_real_distribution<float> U(0.0f, 1.0f);
   for (int i = 0; i < 20000; ++i) {
     glm::vec3 d = uniformSphere(rng);
-    base.splat(glm::vec3(U(rng), U(rng) * U(rng), U(rng)), d, radiance(d));  // uneven regions
+    base.splat(glm::vec3(U(rng), U(rng) * U(rng), U(rng)), 0, d, radiance(d));  // uneven regions
   }
   base.endIteration(0);
   ASSERT_GE(base.leafCount(), 16u);
@@ -514,8 +532,9 @@ TEST(Guiding, BoxFilteredSplatSpreadsByOverlapAndConservesItsValue) {
 
 // The spatial filter: a splat shared among the regions a box of its region's size around the
 // vertex overlaps, by the overlapped volume over the box's (clipped to the root box), each share
-// in that region's directional tree; the splat count stays with the vertex's region. Regions of
-// the split rule's test (16 leaves of a 4 x 2 x 1 box).
+// in that region's directional tree; the splat count stays with the vertex's region, and the
+// splat with the regions of its orientation class. Regions of the split rule's test (16 leaves of
+// a 4 x 2 x 1 box in class 0, one leaf for each other class).
 TEST(Guiding, SpatialFilterSharesASplatAmongRegionsByOverlappedVolume) {
   GuideSettings s;
   s.spatialThreshold = 100;
@@ -523,15 +542,15 @@ TEST(Guiding, SpatialFilterSharesASplatAmongRegionsByOverlappedVolume) {
   GuideTree t(glm::vec3(0.0f), glm::vec3(4.0f, 2.0f, 1.0f), s);
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> U(0.0f, 1.0f);
-  for (int i = 0; i < 1000; ++i) t.splat(glm::vec3(4 * U(rng), 2 * U(rng), U(rng)), glm::vec3(0, 0, 1), 1.0);
+  for (int i = 0; i < 1000; ++i) t.splat(glm::vec3(4 * U(rng), 2 * U(rng), U(rng)), 0, glm::vec3(0, 0, 1), 1.0);
   t.endIteration(0);
-  ASSERT_EQ(t.leafCount(), 16u);
+  ASSERT_EQ(t.leafCount(), 16u + GUIDE_ORIENTATIONS - 1);
   // Near inner boundaries (shared), and at the root box's corner (the box cut there: its own
   // region only, the whole value kept).
   for (glm::vec3 x : {glm::vec3(1.9f, 0.55f, 0.45f), glm::vec3(3.0f, 1.5f, 0.8f), glm::vec3(0.01f, 0.01f, 0.01f)}) {
     GuideTree u = t;
-    const std::uint32_t home = u.findLeaf(x);
-    u.splat(x, glm::vec3(0, 0, 1), 2.0);
+    const std::uint32_t home = u.findLeaf(x, 0);
+    u.splat(x, 0, glm::vec3(0, 0, 1), 2.0);
     glm::vec3 hlo, hhi;
     u.leafBounds(home, hlo, hhi);
     const glm::dvec3 half = 0.5 * (glm::dvec3(hhi) - glm::dvec3(hlo));
@@ -543,7 +562,7 @@ TEST(Guiding, SpatialFilterSharesASplatAmongRegionsByOverlappedVolume) {
     for (std::uint32_t l = 0; l < u.leafCount(); ++l) {
       glm::vec3 lo, hi;
       u.leafBounds(l, lo, hi);
-      double v = 1;
+      double v = u.leafOrientation(l) == 0 ? 1 : 0;  // other classes' regions get nothing
       for (int a = 0; a < 3; ++a) v *= overlap(blo[a], bhi[a], lo[a], hi[a]);
       const double got = u.buildingTree(l).total();
       EXPECT_NEAR(got, 2.0 * v / volume, 1e-12) << "leaf " << l;
@@ -559,11 +578,11 @@ TEST(Guiding, SpatialFilterSharesASplatAmongRegionsByOverlappedVolume) {
   s.spatialFilter = false;
   GuideTree v(glm::vec3(0.0f), glm::vec3(4.0f, 2.0f, 1.0f), s);
   std::mt19937 rng2(5);
-  for (int i = 0; i < 1000; ++i) v.splat(glm::vec3(4 * U(rng2), 2 * U(rng2), U(rng2)), glm::vec3(0, 0, 1), 1.0);
+  for (int i = 0; i < 1000; ++i) v.splat(glm::vec3(4 * U(rng2), 2 * U(rng2), U(rng2)), 0, glm::vec3(0, 0, 1), 1.0);
   v.endIteration(0);
   const glm::vec3 x(1.9f, 0.55f, 0.45f);
-  v.splat(x, glm::vec3(0, 0, 1), 2.0);
-  EXPECT_NEAR(v.buildingTree(v.findLeaf(x)).total(), 2.0, 1e-12);
+  v.splat(x, 0, glm::vec3(0, 0, 1), 2.0);
+  EXPECT_NEAR(v.buildingTree(v.findLeaf(x, 0)).total(), 2.0, 1e-12);
 }
 
 // The selection probability per region (GuideTree::observeSelection, learnAlphas) on a one-leaf
