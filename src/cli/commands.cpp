@@ -333,7 +333,7 @@ int renderCommand(const RenderArgs& a) {
       const std::uint32_t trained = std::min<std::uint64_t>(planned, rec.spp);
       std::string why = trained < planned ? " of " + std::to_string(planned) + " (stopped during training)" : "";
       if (loop.trainingEndedAt())
-        why = " (ended by the time budget: the next iteration would have left less than its own time to sample its guide)";
+        why = " (ended by the time budget: the next iteration would have left less than twice its own time to sample its guide)";
       std::fprintf(stderr, "guiding: %u training spp%s, %.3f s of CPU time reading records, splatting and refining\n",
                    trained, why.c_str(), guide->trainingSeconds());
     }
@@ -901,7 +901,7 @@ int runCli(int argc, char** argv) {
   render->add_option("--guide-train", ra.guideTrain, "Training samples per pixel of the guide, in iterations of 1, 2, 4, "
                                                      "... spp (0: the largest 2^k - 1 up to half of --spp, at most 127; "
                                                      "with --time, ended earlier when the next iteration would leave less "
-                                                     "than its own time to sample its guide)")
+                                                     "than twice its own time to sample its guide)")
       ->capture_default_str()->check(CLI::Range(0u, 1u << 30));
   render->add_option("--guide-memory", ra.guideMemoryMiB, "Memory cap of the guide's trees on the device, MiB")
       ->capture_default_str()->check(CLI::Range(0.01, 4096.0));

@@ -25,7 +25,7 @@ struct RenderLoopOptions {
   bool quiet = false;
   bool progress = true;          // a progress bar on a terminal, a summary line otherwise
   // Guided renders with a time budget: end the guide's training at the end of an iteration when the
-  // next one (twice its samples) would leave less than its own time for rendering with its guide
+  // next one (twice its samples) would leave less than twice its own time for rendering with its guide
   // (docs/guiding.md, "Training within a time budget"). Off when the training spp were asked for
   // (--guide-train) or come from a resumed render's record.
   bool trainingWithinBudget = false;

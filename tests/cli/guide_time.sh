@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Guided renders with a time budget (docs/guiding.md, "Training within a time budget"): the
-# automatic training ends at the end of an iteration when the next one would leave less than its
-# own time; the record states the spp actually trained, so a resumed render retrains exactly those
+# automatic training ends at the end of an iteration when the next one would leave less than twice
+# its own time; the record states the spp actually trained, so a resumed render retrains exactly those
 # (no guide-hash warning). A training spp asked for with --guide-train is kept as asked.
 # Usage: guide_time.sh NUSSELT SOURCE_DIR
 set -u
