@@ -182,7 +182,8 @@ class GuideTree {
   }
   // The same for a vertex known to lie in leaf `leaf` (findLeaf(x, o)).
   void splatAt(std::uint32_t leaf, glm::vec3 x, std::uint32_t o, glm::vec3 d, double value, double count = 1.0);
-  // Whether a splat changes nothing outside its own leaf (no spatial filter, or a single leaf):
+  // Whether a splat changes nothing outside its own leaf (no spatial filter, or no root split yet:
+  // each orientation class still one leaf, and the filter stays within a class):
   // then the splats of different leaves can be applied in parallel (splatPaths), each leaf's in
   // their order, giving the same trees bit for bit.
   bool splatsStayInTheirLeaf() const { return !m_settings.spatialFilter || m_nodes.size() == m_settings.orientations; }
