@@ -209,6 +209,10 @@ float guideDescend(GuideVertex v, bool guided, float uDescent, PathKey k, uint b
 // Whether this pass writes training records (the guide's info.x).
 bool guideRecording() { return g.guide.v[0].info.x > 0u; }
 
+// Whether the training records carry the product L_i f cos (the guide's info.w; else L_i alone:
+// guiding::GuideSettings::product).
+bool guideLearnsProduct() { return g.guide.v[0].info.w != 0u; }
+
 // Whether this pass traces photons (the guide's info.y: the photon pre-pass, docs/guiding.md): the
 // paths start at light samples (photon.comp), the shade stages write photon records and neither
 // gather emission nor sample lights, the escape stage does nothing.
@@ -249,8 +253,8 @@ void guideRecordArrival(uint path, uint bounce, vec3 x) {
 }
 
 // The path goes on from vertex `bounce` (geometric normal ng on the path's side) in the world
-// direction wi; value = luminance of the new throughput x the sample's density per steradian, or
-// -1 (a delta sample: not splatted); selection = (guide density, BRDF-sampler density, alpha) of
+// direction wi; value = the record's b.w (guiding_layout.h: what the radiance arriving through
+// the sample is divided by to give the splat), or -1 (a delta sample: not splatted); selection = (guide density, BRDF-sampler density, alpha) of
 // the sample (guiding_layout.h, c).
 // The next record reads "nothing arrived (-1), ended there" until a stage writes its arrival (a
 // ray that leaves a scene without environment, or a path the next bounce ends, never gets one).
@@ -273,6 +277,7 @@ GuideVertex guideVertex(vec3 x, vec3 ng) { return GuideVertex(0u, 0.0f); }
 float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) { return pdfBsdf; }
 float guideDescend(GuideVertex v, bool guided, float uDescent, PathKey k, uint bounce, inout vec3 w) { return 0.0f; }
 bool guideRecording() { return false; }
+bool guideLearnsProduct() { return false; }
 bool guidePhotons() { return false; }
 void guideRecordPhoton(uint path, uint bounce, vec3 x, vec3 ng, vec3 wFrom, float value) {}
 void guideRecordArrival(uint path, uint bounce, vec3 x) {}

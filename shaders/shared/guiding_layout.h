@@ -68,16 +68,20 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer GuideRecord
 //   a = (position of vertex k (xyz), luminance of the path's radiance when its ray arrived at
 //        vertex k, before anything vertex k adds; -1: the ray left the scene without an
 //        environment, so nothing arrived);
-//   b = (sampled direction (world, unit), luminance of the throughput after the sample x the
-//        density of the sample per steradian; 0: the path ended at vertex k; -1: it went on
-//        from a vertex whose sample is not splatted (a delta lobe));
+//   b = (sampled direction (world, unit), the value v that the radiance arriving through the
+//        sample is divided by: with info.w = 0 (the guide learns radiance) the luminance of the
+//        throughput after the sample x the density of the sample per steradian, with info.w = 1
+//        (it learns the product L_i f cos) that luminance over the luminance of the sample's
+//        factor f cos / p; 0: the path ended at vertex k; -1: it went on from a vertex whose
+//        sample is not splatted (a delta lobe));
 //   c = (the guide's density per steradian at the sampled direction (-1: the vertex does not
 //        sample the mixture, a combined material), the BRDF sampler's density there, the
 //        selection probability alpha the sample was drawn with, the vertex's orientation class
 //        (guideOrientation)); read only when b.w > 0.
 // The radiance that reached vertex k from its sampled direction is then (path radiance at the
-// end - a.w of record k + 1) / (luminance of the throughput), and the splat is that divided by
-// the density (src/guiding/guide_tree.cpp, splatPaths); c lets the trainer estimate, per region,
+// end - a.w of record k + 1) / (luminance of the throughput), and the splat, that divided by the
+// density (L_i / p) or times the factor (L_i f cos / p), is (path radiance at the end - a.w of
+// record k + 1) / b.w (src/guiding/guide_tree.cpp, splatPaths); c lets the trainer estimate, per region,
 // the second moment the vertex's estimate would have under another alpha (GuideTree,
 // observeSelection).
 // Photon records (the photon pre-pass, info.y = 1; the same buffer and slots, path = photon):
@@ -91,7 +95,8 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer GuideRecord
 SHARED_FN uint guideRecordIndex(uint path, uint k, uint paths) { return (k * paths + path) * GUIDE_RECORD_VEC4S; }
 // boundsMin, boundsMax: the spatial tree's root box (w unused);
 // info = (records per path, 0: not recording; 1: the photon pre-pass, else 0; spatial roots:
-//         GUIDE_ORIENTATIONS (one per orientation class) or 1 (every vertex at node 0); 0).
+//         GUIDE_ORIENTATIONS (one per orientation class) or 1 (every vertex at node 0); 1: the
+//         records' b.w makes the splats L_i f cos / p, 0: L_i / p (GuideSettings::product)).
 struct GpuGuide {
   vec4 boundsMin;
   vec4 boundsMax;

@@ -615,8 +615,15 @@ void continuePath(PathStep s, uint path, uint bounce, uint roulette, vec3 x, vec
     if (GUIDING && s.selection.z > 0.0f && s.selection.y > 0.0f) etaScale *= max(1.0f, s.pdf / s.selection.y);
     if (!throughputRoulette(bounce, beta, etaScale, uR)) return;
   }
-  if (GUIDING && !guidePhotons())
-    guideRecordSample(path, bounce, ng, wi, s.delta ? -1.0f : luminance(beta) * s.pdf, s.selection);
+  if (GUIDING && !guidePhotons()) {
+    // The splat is the luminance that arrives through the sample over this value
+    // (guiding_layout.h, record b): L_i / p with the new throughput x p (the roulette's 1 / q
+    // cancels), or L_i f cos / p (f cos / p = the sample's factor) with the new throughput over
+    // the factor.
+    float fl = luminance(s.factor);
+    float value = guideLearnsProduct() ? (fl > 0.0f ? luminance(beta) / fl : -1.0f) : luminance(beta) * s.pdf;
+    guideRecordSample(path, bounce, ng, wi, s.delta ? -1.0f : value, s.selection);
+  }
   storeVec4(g.pathOrigin, path, vec4(xo, causticState));
   storeVec4(g.pathDirection, path, vec4(wi, s.pdf));
   storeVec4(g.pathThroughput, path, vec4(beta, etaScale));

@@ -77,6 +77,7 @@ struct RenderArgs {
   std::string guideFilter = "box";
   std::string guideSpatialFilter = "none";
   double guideFloor = 0.0;
+  std::string guideLearn = "product";
   std::uint32_t guidePhotons = 0;
   bool variance = false;
   bool validation = false;
@@ -146,6 +147,7 @@ int renderCommand(const RenderArgs& a) {
   s.guideDirFilter = a.guideFilter == "box";
   s.guideSpatialFilter = a.guideSpatialFilter == "box";
   s.guideFloor = a.guideFloor;
+  s.guideProduct = a.guideLearn == "product";
   s.guidePhotons = a.guidePhotons;
   // What Metropolis renders do not support (docs/mlt.md): guiding and the variance of a correlated
   // estimate. A resumed one restarts its chains from a new bootstrap (docs/mlt.md, "Resume").
@@ -211,6 +213,9 @@ int renderCommand(const RenderArgs& a) {
       if (p.guideSpatialFilter != s.guideSpatialFilter)
         refuse("--guide-spatial-filter", box(p.guideSpatialFilter), box(s.guideSpatialFilter));
       if (p.guideFloor != s.guideFloor) refuse("--guide-floor", formatNumber(p.guideFloor), formatNumber(s.guideFloor));
+      auto learn = [](bool product) { return std::string(product ? "product" : "radiance"); };
+      if (p.guideProduct != s.guideProduct)
+        refuse("--guide-learn", learn(p.guideProduct), learn(s.guideProduct));
       if (p.guidePhotons != s.guidePhotons)
         refuse("--guide-photons", std::to_string(p.guidePhotons), std::to_string(s.guidePhotons));
       s.guideTrainSpp = base.settings.guideTrainSpp = p.guideTrainSpp;
@@ -926,6 +931,10 @@ int runCli(int argc, char** argv) {
   render->add_option("--guide-floor", ra.guideFloor, "Weight of the uniform sphere density mixed into the learned "
                                                      "guide (0: none)")
       ->capture_default_str()->check(CLI::Range(0.0, 0.5));
+  render->add_option("--guide-learn", ra.guideLearn, "What the guide learns: product = the incident radiance times the "
+                                                     "BSDF and cosine of the vertices that trained it, radiance = the "
+                                                     "incident radiance alone (docs/guiding.md)")
+      ->capture_default_str()->check(CLI::IsMember({"product", "radiance"}));
   render->add_option("--guide-photons", ra.guidePhotons, "Photons of the guide's pre-pass: traced from the lights before "
                                                          "training, their indirect arrivals train the guide of the first "
                                                          "iteration (0: none; docs/guiding.md)")

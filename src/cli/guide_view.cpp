@@ -50,6 +50,7 @@ struct GuideViewArgs {
   std::string guideFilter = "box";
   std::string guideSpatialFilter = "none";
   double guideFloor = 0.0;
+  std::string guideLearn = "product";
   std::uint32_t guidePhotons = 0;
   int device = -1;
   bool quiet = false;
@@ -127,6 +128,7 @@ int guideViewCommand(const GuideViewArgs& a) {
   s.guideDirFilter = a.guideFilter == "box";
   s.guideSpatialFilter = a.guideSpatialFilter == "box";
   s.guideFloor = a.guideFloor;
+  s.guideProduct = a.guideLearn == "product";
   s.guidePhotons = a.guidePhotons;
   s.spp = a.train;
 
@@ -295,6 +297,8 @@ void registerGuideViewCommand(CLI::App& app, CommandRunner& run) {
       ->capture_default_str()->check(CLI::IsMember({"box", "none"}));
   c->add_option("--guide-floor", a->guideFloor, "Uniform density mixed into the guide (as render --guide-floor)")
       ->capture_default_str()->check(CLI::Range(0.0, 0.5));
+  c->add_option("--guide-learn", a->guideLearn, "What the guide learns: product or radiance (as render --guide-learn)")
+      ->capture_default_str()->check(CLI::IsMember({"product", "radiance"}));
   c->add_option("--guide-photons", a->guidePhotons, "Photons of the guide's pre-pass (as render --guide-photons)")
       ->capture_default_str()->check(CLI::Range(0u, 1u << 30));
   c->add_option("--size", a->size, "Side of each panel in pixels")->capture_default_str()->check(CLI::Range(16u, 4096u));

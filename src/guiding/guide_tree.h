@@ -82,6 +82,12 @@ struct GuideSettings {
   // vertices (guideOrientation: a region's surfaces face one way, docs/guiding.md, "Regions by
   // orientation"), or 1 (every vertex under one root, whatever its normal).
   std::uint32_t orientations = GUIDE_ORIENTATIONS;
+  // What a training splat carries (the shade stage's record value, guiding_layout.h, record b;
+  // GpuGuide.info.w): the incident radiance over the sample's density, L_i / p (false), or the
+  // product with the training vertex's BSDF and cosine, L_i f cos / p (true). The tree itself
+  // splats either the same way; the product is what the sampler would ideally follow, averaged
+  // over the region's vertices and outgoing directions (docs/guiding.md, "What the guide learns").
+  bool product = true;
 };
 
 // A quadtree over the map [0, 1)^2; node 0 is the root. energy[c] of a node = the energy of

@@ -81,7 +81,8 @@ void DeviceGuide::upload() {
   const glm::vec3 lo = m_tree.boundsMin(), hi = m_tree.boundsMax();
   info.boundsMin = shared::vec4(lo, 0.0f);
   info.boundsMax = shared::vec4(hi, 0.0f);
-  info.info = shared::uvec4(m_recording ? m_recordsPerPath : 0u, 0u, m_tree.settings().orientations, 0u);
+  info.info = shared::uvec4(m_recording ? m_recordsPerPath : 0u, 0u, m_tree.settings().orientations,
+                            m_tree.settings().product ? 1u : 0u);
   info.spatial = m_arrays.address;
   info.dir = m_arrays.address + dirOffset;
   info.records = m_records.address;

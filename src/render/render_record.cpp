@@ -121,6 +121,7 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
     meta.strings.push_back({"nusselt/guideFilter", r.settings.guideDirFilter ? "box" : "none"});
     meta.strings.push_back({"nusselt/guideSpatialFilter", r.settings.guideSpatialFilter ? "box" : "none"});
     meta.doubles.push_back({"nusselt/guideFloor", r.settings.guideFloor});
+    meta.strings.push_back({"nusselt/guideLearn", r.settings.guideProduct ? "product" : "radiance"});
     meta.ints.push_back({"nusselt/guidePhotons", static_cast<std::int64_t>(r.settings.guidePhotons)});
     meta.doubles.push_back({"nusselt/guideSpatial", r.settings.guideSpatialThreshold});
     meta.doubles.push_back({"nusselt/guideMemory", double(r.settings.guideMemory)});
@@ -260,6 +261,8 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
   r.settings.guideDirFilter = findString(meta, "nusselt/guideFilter").value_or("none") == "box";
   r.settings.guideSpatialFilter = findString(meta, "nusselt/guideSpatialFilter").value_or("none") == "box";
   r.settings.guideFloor = findDouble(meta, "nusselt/guideFloor").value_or(0.0);
+  // Files from before --guide-learn were trained on radiance.
+  r.settings.guideProduct = findString(meta, "nusselt/guideLearn").value_or("radiance") == "product";
   // Files written before the photon pre-pass: none.
   r.settings.guidePhotons = static_cast<std::uint32_t>(findInt(meta, "nusselt/guidePhotons").value_or(0));
   r.settings.guideSpatialThreshold = findDouble(meta, "nusselt/guideSpatial").value_or(12000);

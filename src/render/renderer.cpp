@@ -190,6 +190,7 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
     gs.dirFilter = settings.guideDirFilter;
     gs.spatialFilter = settings.guideSpatialFilter;
     gs.floor = settings.guideFloor;
+    gs.product = settings.guideProduct;
     m_guide = std::make_unique<DeviceGuide>(m_ctx, lo, hi, gs,
                                             PathIntegrator::capacityFor(settings, pixels, m_samplesPerPass),
                                             settings.maxDepth);

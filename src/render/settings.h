@@ -190,6 +190,10 @@ struct RenderSettings {
   bool guideDirFilter = true;
   bool guideSpatialFilter = false;
   double guideFloor = 0.0;
+  // What the guide learns (`--guide-learn`): the incident radiance L_i (false) or the product
+  // L_i f cos of the vertices that trained it (true, the default: docs/guiding.md, "What the guide
+  // learns"); guiding::GuideSettings::product.
+  bool guideProduct = true;
   // Photons of the guide's pre-pass (`--guide-photons`; 0: none): traced from the lights before
   // the first training iteration, their arrivals after a bounce train the guide that iteration
   // samples (docs/guiding.md, "Photon pre-pass").

@@ -659,9 +659,9 @@ TEST(Guiding, LearnedAlphaPrefersAGoodGuideAndFallsBackWhereBsdfSamplingIsExact)
   EXPECT_EQ(t.leafAlphaVertices(0), 0.0);
 }
 
-// The filter and floor settings in the EXR header (render_record.cpp): written for guided renders,
-// read back as written; a guided header written before they existed reads as unfiltered splats
-// without floor (the behaviour of those files).
+// The filter, floor and learning target settings in the EXR header (render_record.cpp): written
+// for guided renders, read back as written; a guided header written before they existed reads as
+// unfiltered splats without floor, trained on radiance (the behaviour of those files).
 TEST(Guiding, FilterSettingsRoundTripThroughTheRecord) {
   RenderRecord r;
   r.scene = "scene.gltf";
@@ -670,24 +670,28 @@ TEST(Guiding, FilterSettingsRoundTripThroughTheRecord) {
   r.settings.guideDirFilter = false;
   r.settings.guideSpatialFilter = true;
   r.settings.guideFloor = 0.05;
+  r.settings.guideProduct = false;
   ImageMetadata meta = makeMetadata(r);
   RenderRecord back = readRecord("test.exr", meta);
   EXPECT_TRUE(back.settings.guiding);
   EXPECT_FALSE(back.settings.guideDirFilter);
   EXPECT_TRUE(back.settings.guideSpatialFilter);
   EXPECT_EQ(back.settings.guideFloor, 0.05);
+  EXPECT_FALSE(back.settings.guideProduct);
   r.settings.guideDirFilter = true;
   r.settings.guideSpatialFilter = false;
   r.settings.guideFloor = 0;
+  r.settings.guideProduct = true;
   back = readRecord("test.exr", makeMetadata(r));
   EXPECT_TRUE(back.settings.guideDirFilter);
   EXPECT_FALSE(back.settings.guideSpatialFilter);
+  EXPECT_TRUE(back.settings.guideProduct);
   // An older guided header: the keys absent.
   auto drop = [](auto& v) {
     v.erase(std::remove_if(v.begin(), v.end(),
                            [](const auto& kv) {
                              return kv.first == "nusselt/guideFilter" || kv.first == "nusselt/guideSpatialFilter" ||
-                                    kv.first == "nusselt/guideFloor";
+                                    kv.first == "nusselt/guideFloor" || kv.first == "nusselt/guideLearn";
                            }),
             v.end());
   };
@@ -698,4 +702,5 @@ TEST(Guiding, FilterSettingsRoundTripThroughTheRecord) {
   EXPECT_FALSE(back.settings.guideDirFilter);
   EXPECT_FALSE(back.settings.guideSpatialFilter);
   EXPECT_EQ(back.settings.guideFloor, 0.0);
+  EXPECT_FALSE(back.settings.guideProduct);
 }
