@@ -254,8 +254,9 @@ void guideRecordArrival(uint path, uint bounce, vec3 x) {
 
 // The path goes on from vertex `bounce` (geometric normal ng on the path's side) in the world
 // direction wi; value = the record's b.w (guiding_layout.h: what the radiance arriving through
-// the sample is divided by to give the splat), or -1 (a delta sample: not splatted); selection = (guide density, BRDF-sampler density, alpha) of
-// the sample (guiding_layout.h, c).
+// the sample is divided by to give the splat), or -1 (not splatted: a delta sample, or a factor
+// without luminance); selection = (guide density, BRDF-sampler density, alpha) of the sample
+// (guiding_layout.h, c).
 // The next record reads "nothing arrived (-1), ended there" until a stage writes its arrival (a
 // ray that leaves a scene without environment, or a path the next bounce ends, never gets one).
 void guideRecordSample(uint path, uint bounce, vec3 ng, vec3 wi, float value, vec3 selection) {

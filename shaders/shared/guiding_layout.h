@@ -73,7 +73,7 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer GuideRecord
 //        throughput after the sample x the density of the sample per steradian, with info.w = 1
 //        (it learns the product L_i f cos) that luminance over the luminance of the sample's
 //        factor f cos / p; 0: the path ended at vertex k; -1: it went on from a vertex whose
-//        sample is not splatted (a delta lobe));
+//        sample is not splatted (a delta lobe, or a factor without luminance));
 //   c = (the guide's density per steradian at the sampled direction (-1: the vertex does not
 //        sample the mixture, a combined material), the BRDF sampler's density there, the
 //        selection probability alpha the sample was drawn with, the vertex's orientation class
@@ -81,8 +81,8 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer GuideRecord
 // The radiance that reached vertex k from its sampled direction is then (path radiance at the
 // end - a.w of record k + 1) / (luminance of the throughput), and the splat, that divided by the
 // density (L_i / p) or times the factor (L_i f cos / p), is (path radiance at the end - a.w of
-// record k + 1) / b.w (src/guiding/guide_tree.cpp, splatPaths); c lets the trainer estimate, per region,
-// the second moment the vertex's estimate would have under another alpha (GuideTree,
+// record k + 1) / b.w (src/guiding/guide_tree.cpp, splatPaths); c lets the trainer estimate, per
+// region, the second moment the vertex's estimate would have under another alpha (GuideTree,
 // observeSelection).
 // Photon records (the photon pre-pass, info.y = 1; the same buffer and slots, path = photon):
 // record k of photon p, written by the shade stage where the photon's ray of bounce k arrived
