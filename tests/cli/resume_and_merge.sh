@@ -77,6 +77,8 @@ done
 "$nusselt" render "${common[@]}" "${guided[@]}" --spp 3 -o "$work/g3.exr" || fail "guided render of 3 spp"
 expect_refused "guided resume with another --guide-alpha" "--guide-alpha was 0.5" \
   "$nusselt" render "${common[@]}" --guiding on --guide-train 7 --guide-alpha 0.25 --spp 12 --resume "$work/g3.exr"
+expect_refused "guided resume with another --guide-learn" "--guide-learn was product" \
+  "$nusselt" render "${common[@]}" "${guided[@]}" --guide-learn radiance --spp 12 --resume "$work/g3.exr"
 
 # With the photon pre-pass (--guide-photons): the resumed run traces the same photons again before
 # its retraining; a resume with another photon count is refused.
