@@ -157,12 +157,12 @@ SHARED_FN bool guideDirSample(GuideView G, uint root, float uDescent, vec2 uCell
 }
 
 // ---- One-sample MIS with the BRDF sampler ---------------------------------------------------------
-// The guide is chosen with probability alpha, the material's own sampler otherwise; both the
-// sample's weight f cos / p and the MIS weights against light sampling use the mixture's density
-// (Veach's one-sample model, section 9.2.4). The BRDF sampler's density is positive wherever
-// f cos is (every strategy of bsdf_sampling.h is unbiased on its own), so the mixture is too for
-// alpha < 1: the guide needs no floor of its own, and a cell the training never reached is still
-// sampled through the BRDF.
+// The guide is chosen with probability alpha, the material's own sampler otherwise; the sample's
+// weight f cos / p uses the mixture's density (Veach's one-sample model, section 9.2.4), the MIS
+// weights against light sampling the BRDF sampler's (shade_body.glsl, shadeMisPdf). The BRDF
+// sampler's density is positive wherever f cos is (every strategy of bsdf_sampling.h is unbiased
+// on its own), so the mixture is too for alpha < 1: the guide needs no floor of its own, and a
+// cell the training never reached is still sampled through the BRDF.
 SHARED_FN float guideMixturePdf(float alpha, float pdfGuide, float pdfBsdf) {
   return alpha * pdfGuide + (1.0f - alpha) * pdfBsdf;
 }
@@ -186,12 +186,6 @@ GuideVertex guideVertex(vec3 x, vec3 ng) {
   v.root = info.y;
   v.alpha = uintBitsToFloat(info.z);
   return v;
-}
-
-// The mixture's density for the world direction w whose BRDF-sampler density is pdfBsdf.
-float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) {
-  if (!(v.alpha > 0.0f)) return pdfBsdf;
-  return guideMixturePdf(v.alpha, guideDirPdf(g.guide.v[0], v.root, w), pdfBsdf);
 }
 
 // The guide's descent at a vertex of region v (guideSquareDescend): guided, a direction drawn from
@@ -275,7 +269,6 @@ void guideRecordSample(uint path, uint bounce, vec3 ng, vec3 wi, float value, ve
 #else
 // A module without guiding (NUSSELT_SCENE_FEATURES 0, stage_common.glsl): empty stand-ins.
 GuideVertex guideVertex(vec3 x, vec3 ng) { return GuideVertex(0u, 0.0f); }
-float guideMixture(GuideVertex v, vec3 w, float pdfBsdf) { return pdfBsdf; }
 float guideDescend(GuideVertex v, bool guided, float uDescent, PathKey k, uint bounce, inout vec3 w) { return 0.0f; }
 bool guideRecording() { return false; }
 bool guideLearnsProduct() { return false; }

@@ -230,7 +230,8 @@ struct PathStep {
 // shadeLightSamples  whether next-event estimation applies (not for delta materials)
 // shadeTransmits     whether f is not zero below the surface (light samples on both sides)
 // shadeEval          f(wi, wo) (rgb) for a light sample
-// shadeMisPdf        the density with which shadeSample would draw wi (MIS against light sampling)
+// shadeMisPdf        the density MIS weighs a light sample in direction wi against: shadeSample's
+//                    (at a guided vertex, its BRDF sampler's)
 // shadeSample        the next direction, its factor and density (PathStep); false ends the walk
 // nextEvent and continuePath below are written once over them.
 #if !SHADE_COMBINED
@@ -288,10 +289,11 @@ bool shadeTransmits(ShadeMaterial m) { return modelTransmits(MODEL_ID); }
 
 vec3 shadeEval(ShadeMaterial m, vec3 wi, vec3 wo) { return brdfEval(MODEL_ID, m.M.params, wi, wo); }
 
-float shadeMisPdf(ShadeMaterial m, vec3 wo, vec3 wi, vec3 wiWorld) {
-  float pdfB = shadeBsdfPdf(m, wo, wi);
-  if (GUIDING) pdfB = guideMixture(m.gv, wiWorld, pdfB);
-  return pdfB;
+// MIS against light sampling weighs the BRDF sampler's density, also at a guided vertex (not the
+// mixture's: continuePath stores the same for an emitter hit, so the weights still sum to 1; NEE
+// then needs no descent of the guide. docs/guiding.md, "Sampling").
+float shadeMisPdf(ShadeMaterial m, vec3 wo, vec3 wi) {
+  return shadeBsdfPdf(m, wo, wi);
 }
 
 // BSDF sampling, or the guide with probability alpha (one-sample MIS); uR: the roulette's number
@@ -475,7 +477,7 @@ vec3 shadeEval(ShadeMaterial m, vec3 wi, vec3 wo) {
   return f;
 }
 
-float shadeMisPdf(ShadeMaterial m, vec3 wo, vec3 wi, vec3 wiWorld) {
+float shadeMisPdf(ShadeMaterial m, vec3 wo, vec3 wi) {
   float pdf = 0.0f;
   if (COMPONENT_COUNT > 0u) pdf += componentMisPdf(MODEL_0, m.C0, m.c.x, wo, wi);
   if (COMPONENT_COUNT > 1u) pdf += componentMisPdf(MODEL_1, m.C1, m.c.y, wo, wi);
@@ -553,7 +555,7 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
   s.wiLocal = wiLocal;
   s.factor = weight * (wk / p);
   // MIS density of the sampled direction: sum over the non-delta components (0 after a delta lobe).
-  s.pdf = delta ? 0.0f : shadeMisPdf(m, wo, wiLocal, vec3(0.0f));
+  s.pdf = delta ? 0.0f : shadeMisPdf(m, wo, wiLocal);
   s.etaScale = etaK;
   s.delta = delta;
   return true;
@@ -579,7 +581,7 @@ void nextEvent(ShadeMaterial m, uint path, PathKey k, uint bounce, uint lighting
     vec3 f = shadeEval(m, wiL, wo);
     float cosS = transmits ? abs(wiL.z) : max(wiL.z, 0.0f);
     vec3 c = beta * f * cosS * ls.value;
-    if (ls.pdf > 0.0f && lighting == LIGHTING_MIS) c *= powerHeuristic(ls.pdf, shadeMisPdf(m, wo, wiL, ls.wi));
+    if (ls.pdf > 0.0f && lighting == LIGHTING_MIS) c *= powerHeuristic(ls.pdf, shadeMisPdf(m, wo, wiL));
     if (max(c.x, max(c.y, c.z)) > 0.0f) {
       // Stop short of the light so that the emitter itself never occludes.
       float tmax = ls.dist < 1.0e38f ? ls.dist * (1.0f - 1e-4f) : ls.dist;
@@ -624,8 +626,12 @@ void continuePath(PathStep s, uint path, uint bounce, uint roulette, vec3 x, vec
     float value = guideLearnsProduct() ? (fl > 0.0f ? luminance(beta) / fl : -1.0f) : luminance(beta) * s.pdf;
     guideRecordSample(path, bounce, ng, wi, s.delta ? -1.0f : value, s.selection);
   }
+  // The density an emitter or environment hit weighs against light sampling (shadeMisPdf): at a
+  // vertex that sampled the guide's mixture, the BRDF sampler's (never 0 there, which would read
+  // as a delta bounce: a direction the BRDF sampler cannot draw gets a weight that rounds to 0).
+  float misPdf = GUIDING && s.selection.z > 0.0f ? max(s.selection.y, 1e-30f) : s.pdf;
   storeVec4(g.pathOrigin, path, vec4(xo, causticState));
-  storeVec4(g.pathDirection, path, vec4(wi, s.pdf));
+  storeVec4(g.pathDirection, path, vec4(wi, misPdf));
   storeVec4(g.pathThroughput, path, vec4(beta, etaScale));
   queuePush(((bounce + 1u) & 1u), path);
 }
