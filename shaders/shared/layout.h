@@ -482,7 +482,7 @@ struct Globals {
   BUFREF(Vec4s) film;          // per pixel: sum of samples (rgb), w = samples taken
   BUFREF(Vec4s) filmSq;        // per pixel: sum of squared samples (rgb)
   BUFREF(Vec4s) pathOrigin;    // per path: ray origin; w: caustic parts only (else 0): 1 once the path took a non-delta bounce, 2 once its caustic light counted
-  BUFREF(Vec4s) pathDirection; // per path: ray direction, w = pdf of the BSDF sample (0: delta/camera)
+  BUFREF(Vec4s) pathDirection; // per path: ray direction, w = its MIS density against light sampling (the BSDF sampler's pdf, also after a guided sample; 0: delta/camera)
   BUFREF(Vec4s) pathThroughput;// per path: throughput (rgb), w = etaScale (the product of (n_t / n_i)^2 over
                                // refractions, which undoes their radiance scaling for the roulette;
                                // guided renders: also of max(1, p_mix / p_bsdf) over guided bounces)

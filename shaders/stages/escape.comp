@@ -2,8 +2,10 @@
 #extension GL_GOOGLE_include_directive : require
 // escape: rays that left the scene (the escape queue, filled by intersect) pick up the
 // environment's radiance in their direction, weighted by MIS against light sampling of the
-// environment: the power heuristic of the BSDF pdf the ray was drawn with (path direction w) and
-// the pdf with which NEE would have drawn it (selection probability x envPdf). Camera rays and
+// environment: the power heuristic of the BSDF sampler's pdf of the ray's direction (path
+// direction w: the pdf it was drawn with, or after a guided sample the BRDF sampler's, which
+// NEE's weight uses too: shade_body.glsl, shadeMisPdf) and the pdf with which NEE would have
+// drawn it (selection probability x envPdf). Camera rays and
 // rays after a delta lobe (pdf 0) take weight 1. Dispatched only when the scene has an
 // environment (Globals.environmentLight != INVALID_INDEX).
 #include "shared/stage_common.glsl"
