@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # An integrator (--integrator mlt, docs/mlt.md; --integrator vegas, docs/vegas.md) against the
 # path tracer at equal time: for each scene, a converged path-traced reference (rendered once, kept
-# in DIR), then REPEATS interleaved pairs (path, the integrator; seeds 1, 2, ...), each with the
+# in DIR), then REPEATS interleaved pairs (path, the integrator; seeds FIRST_SEED, ..., default 1), each with the
 # same time budget (--time), compared with the reference (relMSE from `nusselt diff`). Prints per
 # run and the medians: relMSE, the render's sampling seconds (header nusselt/renderSeconds; a
 # budget ends at a pass boundary, so the times differ a little), paths per second (mlt: mutations,
@@ -15,13 +15,16 @@
 # moves a lot between runs; the mean estimates the expected error, which equal-time efficiency
 # is about, and its standard error says how far to trust it. The reference's own
 # noise adds the same amount to both relMSEs (give REF_SPP ~10x what a run reaches).
+# Every run's error map goes beside its image (DIR/NAME-MODE-SEED-error.png, `nusselt diff --map`:
+# each pixel grey at its relative error, white at 100 %).
 # A scene written SCENE@x0,y0,x1,y1 is also measured in that region of its image (fractions of the
 # width and height from the top left, `nusselt diff --region`): its relMSE, relMSE x s and ratio
 # are printed for the region as well (e.g. the caustic under the glass sphere).
 #
 #   tools/bench_integrator.sh mlt|vegas [DIR] [NUSSELT]
 # tools/bench_mlt.sh and tools/bench_vegas.sh call it with their integrator's default scenes.
-# Environment: SIZE (default 128), TIME (10 s), REF_SPP (2048), REPEATS (3), DEPTH (8),
+# Environment: SIZE (default 128), TIME (10 s), REF_SPP (2048), REPEATS (3), FIRST_SEED (1: the
+#   repeats use seeds FIRST_SEED .. FIRST_SEED + REPEATS - 1), DEPTH (8),
 #   SCENES (default: the default Cornell box "default"), ARGS (extra options of the integrator's
 #   renders, e.g. "--mlt-chains 32768" or "--vegas-bins 16"), ARGS2, ARGS3 (when set: more variants
 #   of the integrator, named INTEGRATOR-2 and INTEGRATOR-3, interleaved with the others in every
@@ -38,6 +41,7 @@ size=${SIZE:-128}
 budget=${TIME:-10}
 refSpp=${REF_SPP:-2048}
 repeats=${REPEATS:-3}
+firstSeed=${FIRST_SEED:-1}
 depth=${DEPTH:-8}
 scenes=${SCENES:-default}
 mkdir -p "$dir"
@@ -81,7 +85,7 @@ for entry in $scenes; do
   # shellcheck disable=SC2086
   bench_reference "$bin" "$scene" "$ref" "$refSpp" $common
   for mode in "${modes[@]}"; do : > "$dir/$name.$mode"; : > "$dir/$name.$mode.region"; done
-  for ((r = 1; r <= repeats; r++)); do
+  for ((r = firstSeed; r < firstSeed + repeats; r++)); do
     for mode in "${modes[@]}"; do
       out="$dir/$name-$mode-$r.exr"
       extra=$(variantArgs "$mode")
@@ -89,7 +93,7 @@ for entry in $scenes; do
       "$bin" render $sceneArg $common --time "$budget" --seed "$r" --integrator "${mode%-[23]}" $extra -o "$out"
       sec=$(attr "$out" renderSeconds)
       spp=$(attr "$out" spp)
-      rel=$("$bin" diff "$out" "$ref" | awk '{print $2}')
+      rel=$("$bin" diff "$out" "$ref" --map "${out%.exr}-error.png" | awk '{print $2}')
       # Paths per spp: one per pixel, or chains x steps for Metropolis (mutations; files without
       # mltSteps moved each chain once per iteration).
       steps=$(attr "$out" mltSteps)

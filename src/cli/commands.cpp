@@ -669,7 +669,7 @@ int infoCommand(const std::vector<std::string>& files) {
   return kExitOk;
 }
 
-int diffCommand(const std::string& a, const std::string& b, const std::string& regionText) {
+int diffCommand(const std::string& a, const std::string& b, const std::string& regionText, const std::string& mapPath) {
   std::vector<double> region;
   if (!regionText.empty()) {
     std::size_t at = 0;
@@ -700,6 +700,7 @@ int diffCommand(const std::string& a, const std::string& b, const std::string& r
   ImageDifference d = compareImages(ia, ib);
   std::printf("relMSE %.6g  MSE %.6g  mean %.6g (%s) vs %.6g (%s)  max |diff| %.6g\n", d.relMse, d.mse, d.meanA,
               a.c_str(), d.meanB, b.c_str(), d.maxAbs);
+  if (!mapPath.empty()) writePng(mapPath, errorMap(ia, ib));
   return kExitOk;
 }
 
@@ -1016,6 +1017,10 @@ int runCli(int argc, char** argv) {
   diff->add_option("--region", diffRegion,
                    "Compare only the region x0,y0,x1,y1, fractions of the width and height from the top left "
                    "(e.g. 0.25,0.5,0.75,1 for the middle of the lower half)");
+  std::string diffMap;
+  diff->add_option("--map", diffMap,
+                   "Also write a PNG of where the error is: each pixel grey at its relative RMS error (the root of "
+                   "its relMSE), white at 100 % or more (of the region, with --region)");
 
   CommandRunner run;
   registerSamplerCommands(app, *bench, run);
@@ -1041,7 +1046,7 @@ int runCli(int argc, char** argv) {
     if (*info) return infoCommand(infoFiles);
     if (*merge) return mergeCommand(mergeInputs, mergeOutput);
     if (*albedo) return albedoCommand(aa);
-    if (*diff) return diffCommand(diffA, diffB, diffRegion);
+    if (*diff) return diffCommand(diffA, diffB, diffRegion, diffMap);
   } catch (const Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return kExitFailure;

@@ -467,6 +467,25 @@ void writePng(const std::string& path, const Image& image, float exposureStops) 
   tmp.commit();
 }
 
+Image errorMap(const Image& a, const Image& reference) {
+  compareImages(a, reference);  // its size checks
+  Image map;
+  map.width = a.width;
+  map.height = a.height;
+  map.rgb.resize(a.rgb.size());
+  for (size_t p = 0; p + 2 < a.rgb.size(); p += 3) {
+    double rel = 0;
+    for (size_t c = 0; c < 3; ++c) {
+      const double diff = double(a.rgb[p + c]) - double(reference.rgb[p + c]);
+      rel += diff * diff / (double(reference.rgb[p + c]) * reference.rgb[p + c] + 0.01);
+    }
+    const double e = std::sqrt(rel / 3.0);
+    const float v = std::isnan(e) ? 1.0f : static_cast<float>(std::min(e, 1.0));
+    map.rgb[p] = map.rgb[p + 1] = map.rgb[p + 2] = v;
+  }
+  return map;
+}
+
 ImageDifference compareImages(const Image& a, const Image& reference) {
   auto checkSize = [](const Image& image, const char* which) {
     size_t expected = size_t(3) * size_t(std::max(image.width, 0)) *

@@ -85,6 +85,10 @@ struct ImageDifference {
   double maxAbs = 0;  // max |x - ref|; NaN if any difference is NaN
 };
 ImageDifference compareImages(const Image& a, const Image& reference);
+// A map of where the error is (`nusselt diff --map`): each pixel grey at its relative RMS error
+// sqrt(mean over its channels of (x - ref)^2 / (ref^2 + 0.01)), the per-pixel root of relMse,
+// clamped to [0, 1] (white: 100 % or more; NaN: white). Throws as compareImages.
+Image errorMap(const Image& a, const Image& reference);
 
 // The pixels an image's region [x0, x1) x [y0, y1) touches, given as fractions of its width and
 // height (0 <= x0 < x1 <= 1, likewise y; at least one pixel): a region of interest that means the

@@ -418,6 +418,18 @@ TEST(ImageCompare, KnownInputs) {
   nan.rgb[4] = std::nanf("");
   EXPECT_TRUE(std::isnan(compareImages(nan, ref).maxAbs));
 
+  // The error map: per pixel the root of its relMse, clamped to 1; NaN is white.
+  Image near = ref;
+  near.rgb = {1.1f, 1.0f, 1.0f, 0.0f, 0.0f, 1.0f};
+  Image m = errorMap(near, ref);
+  ASSERT_EQ(m.width, 2);
+  ASSERT_EQ(m.rgb.size(), 6u);
+  EXPECT_NEAR(m.rgb[0], std::sqrt(double(0.1f) * double(0.1f) / 1.01 / 3.0), 1e-7);
+  EXPECT_EQ(m.rgb[1], m.rgb[0]);
+  EXPECT_EQ(m.rgb[3], 0.0f);
+  EXPECT_EQ(errorMap(a, ref).rgb[0], 1.0f);  // (1 + 4) / 1.01 / 3 > 1
+  EXPECT_EQ(errorMap(nan, ref).rgb[3], 1.0f);
+
   Image other = ref;
   other.width = 1;
   other.height = 2;
