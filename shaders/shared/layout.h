@@ -431,10 +431,13 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer Mlts { GpuM
 // high word), read and emptied by the host after each pass.
 struct GpuVegas {
   uvec4 info;
+  // (the table's epoch: tables learned so far, 0 while the table is the uniform one; 1 when the
+  // warped axes' numbers are rotated, vegasRotation; 0, 0).
+  uvec4 epoch;
   BUFREF(Floats) cdf;
   BUFREF(Uints) sums;
 };
-STATIC_ASSERT_SIZE(GpuVegas, 32);
+STATIC_ASSERT_SIZE(GpuVegas, 48);
 #ifndef __cplusplus
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Vegases { GpuVegas v[]; };
 #endif

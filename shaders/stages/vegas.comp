@@ -36,6 +36,7 @@ void main() {
         if (a == 0xffffffffu) continue;
         float pdf;
         uint bin;
+        if (V.epoch.y != 0u) u[c] = vegasRotate(u[c], vegasRotation(pixel, V.epoch.x, d, c, g.seed));
         u[c] = vegasWarp(cdf, a * (bins + 1u), bins, u[c], pdf, bin);
       }
       primary.v[primarySampleIndex(i, d, dims)] = u;

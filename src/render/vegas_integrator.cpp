@@ -140,6 +140,11 @@ void VegasIntegrator::learn(std::uint64_t paths) {
   }
   std::memset(sums, 0, std::size_t(m_axes) * m_bins * 8);
   ++m_report.refinements;
+  // The next pass's table depends on this pass's numbers: its warped numbers are rotated
+  // (vegasRotation), unless no table ever leaves the uniform one (alpha 1: no adaptation, the
+  // path tracer's numbers bit for bit).
+  GpuVegas& v = *static_cast<GpuVegas*>(m_vegas->mapped);
+  v.epoch = {m_report.refinements, m_settings.vegasAlpha < 1.0f ? 1u : 0u, 0u, 0u};
   m_report.learnedPaths += paths;
   m_report.learnSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
