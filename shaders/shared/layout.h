@@ -410,6 +410,12 @@ struct GpuMlt {
   // of the first sample of this trace, samples per pixel per iteration, samples per pixel in this
   // trace, 0); y = 0: all light in the chains.
   uvec4 outside;
+  // Chains restarted from the pass's paths (RenderSettings::mltRestart, docs/mlt.md "Restarts"):
+  // (where MLT_KERNEL_START takes the starts' vectors: 0 the bootstrap pool, 1 the pass pool; the
+  // number of the pass pool's first sample; 0; the pass pool's size, 0: none is recorded). Pass
+  // pool path i is sample restart.y + i / pixels of pixel i % pixels (mltPixelDraw); its f goes
+  // into poolF[i].
+  uvec4 restart;
   BUFREF(Vec2s) vectorsB;
   BUFREF(Vec4s) state;
   BUFREF(Uints) splats;
@@ -419,7 +425,7 @@ struct GpuMlt {
   BUFREF(Uints) extent;
   BUFREF(Uints) written;
 };
-STATIC_ASSERT_SIZE(GpuMlt, 144);
+STATIC_ASSERT_SIZE(GpuMlt, 160);
 #ifndef __cplusplus
 layout(buffer_reference, std430, buffer_reference_align = 16) buffer Mlts { GpuMlt v[]; };
 #endif

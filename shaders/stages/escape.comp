@@ -39,5 +39,10 @@ void main() {
     vec3 beta = loadVec4(g.pathThroughput, path).xyz;
     vec4 R = loadVec4(g.pathRadiance, path);
     storeVec4(g.pathRadiance, path, vec4(R.xyz + beta * envRadiance(E, dir) * w, R.w));
+  } else if (PRIMARY_SAMPLES && w > 0.0f && g.radiancePart == RADIANCE_NONCAUSTIC && caustic) {
+    // The caustic light a Metropolis pass leaves to the chains: its luminance in w (shade_body.glsl).
+    vec3 beta = loadVec4(g.pathThroughput, path).xyz;
+    vec4 R = loadVec4(g.pathRadiance, path);
+    storeVec4(g.pathRadiance, path, vec4(R.xyz, luminance(max(beta * envRadiance(E, dir) * w, vec3(0.0f)))));
   }
 }

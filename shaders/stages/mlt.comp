@@ -43,7 +43,14 @@ void main() {
   if (MLT_KERNEL == MLT_KERNEL_START) {
     if (c >= chains) return;
     uint i = m.start.v[c];
-    for (uint d = 0u; d < dims; ++d) primary.v[primarySampleIndex(c, d, dims)] = mltPoolSample(i, d, m.pool.w);
+    if (m.restart.x != 0u) {
+      // A pass pool's path: the path tracer's numbers of its pixel and sample.
+      uint pixel = i % m.info.w, number = m.restart.y + i / m.info.w;
+      for (uint d = 0u; d < dims; ++d)
+        primary.v[primarySampleIndex(c, d, dims)] = mltPixelDraw(g.rngMode, pixel, number, d, g.seed, uvec2(g.width, g.height));
+    } else {
+      for (uint d = 0u; d < dims; ++d) primary.v[primarySampleIndex(c, d, dims)] = mltPoolSample(i, d, m.pool.w);
+    }
   } else if (MLT_KERNEL == MLT_KERNEL_RECORD) {
     if (c >= m.pool.y) return;
     m.poolF.v[m.pool.x + c] = luminance(tracedRadiance(c));
@@ -117,7 +124,18 @@ void main() {
   } else if (MLT_KERNEL == MLT_KERNEL_PIXEL_ADD) {
     if (c >= m.pool.y) return;
     vec3 sum = vec3(0.0f);
-    for (uint k = 0u; k < m.outside.z; ++k) sum += tracedRadiance(k * m.pool.y + c);
+    for (uint k = 0u; k < m.outside.z; ++k) {
+      uint slot = k * m.pool.y + c;
+      sum += tracedRadiance(slot);
+      // The pass pool (GpuMlt.restart): f of the caustic light the path left to the chains, which
+      // the shade and escape stages keep in its radiance's w.
+      uint number = m.outside.x + k;
+      if (m.restart.w != 0u && number >= m.restart.y && number - m.restart.y <= m.restart.w / m.info.w) {
+        uint at = (number - m.restart.y) * m.info.w + m.pool.x + c;
+        float f = g.pathRadiance.v[slot].w;
+        if (at < m.restart.w) m.poolF.v[at] = isFinite(f) ? max(f, 0.0f) : 0.0f;
+      }
+    }
     g.film.v[m.pool.x + c].xyz += sum / float(m.outside.y);
   } else if (MLT_KERNEL == MLT_KERNEL_ADVANCE) {
     if (c == 0u) {

@@ -699,6 +699,7 @@ void main() {
   bool caustic = causticState == 1.0f && bounce > 0u && prevPdf == 0.0f;
   bool emits = (M.info.y & MATERIAL_EMISSIVE) != 0u && frontFace && !photon;
   if (caustic && emits) causticState = 2.0f;
+  float causticF = 0.0f;
 
   // ---- Emission: one-sided emitters radiate along their geometric normal ----
   if (emits) {
@@ -712,6 +713,9 @@ void main() {
       }
     }
     if (radiancePartKeeps(part, bounce, caustic)) L += beta * Le * w;
+    // A Metropolis pass of the light outside the chains keeps, in its radiance's w, the luminance
+    // of the caustic light it leaves to them: the chains' f of its vector (mlt.h, pass pools).
+    else if (PRIMARY_SAMPLES && part == RADIANCE_NONCAUSTIC && caustic) causticF = luminance(max(beta * Le * w, vec3(0.0f)));
   }
 
   // ---- Local frame: surfaces are two-sided, shade the side the ray came from ----
@@ -736,9 +740,9 @@ void main() {
   if (!last && !photon && lighting != LIGHTING_BSDF_ONLY && shadeLightSamples(m) && radiancePartKeeps(part, bounce + 1u, false))
     nextEvent(m, path, key, bounce, lighting, x, xo, ng, tt, bb, ns, wo, beta);
 
-  if (L != vec3(0.0f)) {
+  if (L != vec3(0.0f) || (PRIMARY_SAMPLES && causticF != 0.0f)) {
     vec4 R = loadVec4(g.pathRadiance, path);
-    storeVec4(g.pathRadiance, path, vec4(R.xyz + L, R.w));
+    storeVec4(g.pathRadiance, path, vec4(R.xyz + L, PRIMARY_SAMPLES && causticF != 0.0f ? causticF : R.w));
   }
   if (last) return;
 

@@ -66,6 +66,7 @@ struct RenderArgs {
   std::uint32_t mltPassSpp = RenderSettings{}.mltPassSpp;
   std::string mltChainLight = mltChainLightName(RenderSettings{}.mltChainLight);
   std::uint32_t mltSteps = RenderSettings{}.mltSteps;
+  std::string mltRestart = "auto";
   std::uint32_t vegasBins = 64;
   std::uint32_t vegasBounces = 1;
   float vegasAlpha = 0.2f;
@@ -98,6 +99,17 @@ float parseGuideAlpha(const std::string& text, float maxAlpha) {
   if (text.empty() || *end != '\0' || !(v >= 0.0 && v <= maxAlpha))
     throw Error("--guide-alpha " + text + ": auto or a number in [0, " + std::to_string(maxAlpha).substr(0, 4) + "]");
   return static_cast<float>(v);
+}
+
+// --mlt-restart: "auto" (kMltRestartAuto), "off" or 0 (never), or samples per pixel.
+std::uint32_t parseMltRestart(const std::string& text) {
+  if (text == "auto") return kMltRestartAuto;
+  if (text == "off") return 0;
+  char* end = nullptr;
+  const unsigned long long v = std::strtoull(text.c_str(), &end, 10);
+  if (text.empty() || text[0] == '-' || *end != '\0' || v >= kMltRestartAuto)
+    throw Error("--mlt-restart " + text + ": auto, off or a number of samples per pixel");
+  return static_cast<std::uint32_t>(v);
 }
 
 int renderCommand(const RenderArgs& a) {
@@ -134,6 +146,7 @@ int renderCommand(const RenderArgs& a) {
   s.mltKelemen = a.mltWeights == "kelemen";
   s.mltPassSpp = a.mltPassSpp;
   s.mltSteps = a.mltSteps;
+  s.mltRestart = parseMltRestart(a.mltRestart);
   if (!parseMltChainLight(a.mltChainLight, s.mltChainLight))
     throw Error("--mlt-chain-light " + a.mltChainLight + ": caustic or indirect");
   s.vegasBins = a.vegasBins;
@@ -354,6 +367,12 @@ int renderCommand(const RenderArgs& a) {
                    m.bPrime > 0 ? ("Kelemen weights, b' = " + std::to_string(m.bPrime)).c_str() : "plain splats", static_cast<unsigned long long>(m.proposals), 100.0 * m.acceptance(),
                    m.proposals ? 100.0 * double(m.largeProposals) / double(m.proposals) : 0.0,
                    m.largeProposals ? 100.0 * double(m.largeAccepted) / double(m.largeProposals) : 0.0);
+      if (const std::uint32_t n = mltRestartSpp(rec.settings, std::uint64_t(rec.settings.width) * rec.settings.height))
+        std::fprintf(stderr, "mlt: the chains started again %u time(s), each from the path-traced pass's last %u sample(s) "
+                             "per pixel (--mlt-restart)\n", m.restarts, n);
+      if (m.startMismatches)
+        std::fprintf(stderr, "mlt: warning: %llu chain start(s) re-traced to a path other than their pool path's (a bug: "
+                             "the image may be biased)\n", static_cast<unsigned long long>(m.startMismatches));
     }
     if (const VegasIntegrator* vegas = renderer.vegas(); vegas && !a.quiet) {
       const VegasReport& v = vegas->report();
@@ -892,6 +911,11 @@ int runCli(int argc, char** argv) {
                      "mlt: path-traced samples per pixel per iteration of the light the chains do not carry "
                      "(--mlt-chain-light); 0: the chains carry all light (docs/mlt.md)")
       ->capture_default_str()->check(CLI::Range(0u, 64u));
+  render->add_option("--mlt-restart", ra.mltRestart,
+                     "mlt: start the caustic chains again from the path-traced pass's paths whenever it has traced "
+                     "this many samples per pixel since their last start; auto: as many as make a bootstrap pool "
+                     "(--mlt-bootstrap) of paths; off: never (docs/mlt.md, \"Restarts\")")
+      ->capture_default_str();
   render->add_option("--vegas-bins", ra.vegasBins, "vegas: bins of each warped axis's density (1 .. 4096)")
       ->capture_default_str();
   render->add_option("--vegas-bounces", ra.vegasBounces, "vegas: bounces whose light choice, light point and BSDF "

@@ -14,12 +14,17 @@ namespace nusselt {
 using shared::GpuMlt;
 using shared::Globals;
 
+namespace {
+constexpr std::uint64_t kMaxRestartPaths = 1ull << 26;  // 256 MiB of f values
+}
+
 std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t slots, std::uint32_t dims,
-                                      std::uint32_t bootstrap, std::uint64_t pixels) {
+                                      std::uint32_t bootstrap, std::uint64_t pixels, std::uint32_t restartSpp) {
   // The second vector buffer, states, start indices, extents, stored draws; splat sums; the
-  // bootstrap's f values (and the chunk of b' for Kelemen's weights); GpuMlt, counters.
+  // bootstrap's f values (and the chunk of b' for Kelemen's weights), or the restart pool's if
+  // larger; GpuMlt, counters.
   return std::uint64_t(shared::primarySampleSlots(chains)) * dims * 8ull + std::uint64_t(chains) * 32 + pixels * 24 +
-         (std::uint64_t(bootstrap) + slots) * 4 + 256;
+         std::max<std::uint64_t>(std::uint64_t(bootstrap) + slots, std::uint64_t(restartSpp) * pixels) * 4 + 256;
 }
 
 std::uint32_t MltIntegrator::pathSlotsFor(const RenderSettings& s, std::uint64_t pixels) {
@@ -40,6 +45,16 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   if (m_dims == 0 || m_chains == 0) throw Error("mlt: the path tracer has no primary samples");
   if (m_paths->capacity() < m_chains) throw Error("mlt: the path tracer has fewer path slots than chains");
   m_poolSize = mltBootstrapPaths(settings);
+  const std::uint32_t restartSpp = mltRestartSpp(settings, pixels);
+  if (restartSpp && (settings.mltPassSpp == 0 || settings.mltChainLight != RADIANCE_CAUSTIC))
+    throw Error("mlt: --mlt-restart needs the caustic chains' path-traced pass (--mlt-pass-spp > 0, --mlt-chain-light "
+                "caustic): the chains restart from its paths");
+  // The restart pool: mltRestart samples of every pixel (whole sweeps, so that its paths cover the
+  // image evenly: the pool's mean is then an unbiased b).
+  const std::uint64_t restartPaths = std::uint64_t(restartSpp) * pixels;
+  if (restartPaths > kMaxRestartPaths)
+    throw Error("mlt: --mlt-restart " + std::to_string(restartSpp) + " x " + std::to_string(pixels) +
+                " pixels is a pool of more than 2^26 paths; give fewer samples per pixel");
   m_report.chains = m_chains;
   m_report.dims = m_dims;
   m_report.bootstrapPaths = m_poolSize;
@@ -47,9 +62,11 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m_mlt = make(sizeof(GpuMlt), "mlt state", true);
   // The chains' second vector buffer (the first is the path tracer's primarySamples).
   vk::Buffer* vectorsB = make(std::uint64_t(shared::primarySampleSlots(m_chains)) * m_dims * 8, "mlt vectors");
-  vk::Buffer* state = make(std::uint64_t(m_chains) * 16, "mlt chain states");
+  m_state = make(std::uint64_t(m_chains) * 16, "mlt chain states");
+  vk::Buffer* state = m_state;
   m_splats = make(m_pixels * 24, "mlt splats");
-  m_poolF = make((std::uint64_t(m_poolSize) + m_paths->capacity()) * 4, "mlt bootstrap");
+  m_poolF = make(std::max<std::uint64_t>(std::uint64_t(m_poolSize) + m_paths->capacity(), restartPaths) * 4,
+                 "mlt bootstrap");
   m_start = make(std::uint64_t(m_chains) * 4, "mlt chain starts");
   vk::Buffer* extent = make(std::uint64_t(m_chains) * 4, "mlt chain extents");
   vk::Buffer* written = make(std::uint64_t(m_chains) * 4, "mlt stored draws");
@@ -69,6 +86,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m.extent = extent->address;
   m.written = written->address;
   m.outside = {0u, settings.mltPassSpp, 0u, 0u};
+  m.restart = {0u, 0u, 0u, static_cast<std::uint32_t>(restartPaths)};
   globals.host().mlt = m_mlt->address;
 
   VkCommandBuffer cmd = vk::beginOneShot(m_ctx);
@@ -113,38 +131,8 @@ void MltIntegrator::bootstrap(std::uint32_t firstSample) {
   std::vector<float>& f = m_poolValues;
   f.resize(m_poolSize);
   vk::downloadBuffer(m_ctx, *m_poolF, f.data(), std::uint64_t(m_poolSize) * 4);
-  // b and the cumulative sums in double, in pool order (deterministic).
-  std::vector<double> cdf(m_poolSize + 1, 0.0);
-  for (std::uint32_t i = 0; i < m_poolSize; ++i) {
-    const double fi = std::max(0.0, double(f[i]));
-    m_report.nonzeroBootstrap += fi > 0 ? 1 : 0;
-    cdf[i + 1] = cdf[i] + fi;
-  }
-  const double total = cdf[m_poolSize];
-  m_report.b = total / double(m_poolSize);
-  if (total > 0) {
-    // Stratified resampling: chain c starts at the pool path whose cdf interval holds (c + u) /
-    // chains of the total, u uniform (48 bits from a hash of (c, seed)). Chain c's start is drawn
-    // from its own stratum of the cdf; over the chains, whose mean is the image, the starts are
-    // in proportion to f_i, so E[b x mean over chains of h(X_0)] = E[(1/B) sum_i f_i h(x_i)] still,
-    // and each pool path starts within one chain of its expected count (independent draws
-    // scattered the counts multinomially).
-    std::vector<std::uint32_t> start(m_chains);
-    for (std::uint32_t c = 0; c < m_chains; ++c) {
-      const glm::uvec4 h = shared::pcg4d(glm::uvec4(c, seed, MLT_STREAM_START, 0x9e3779b9u));
-      const double u = (double(h.x >> 8) * 16777216.0 + double(h.y >> 8)) / 281474976710656.0;
-      const double target = (double(c) + u) / double(m_chains) * total;
-      auto it = std::upper_bound(cdf.begin() + 1, cdf.end(), target);
-      std::uint32_t i = static_cast<std::uint32_t>(std::min<std::ptrdiff_t>(it - cdf.begin() - 1, m_poolSize - 1));
-      while (i > 0 && f[i] <= 0.0f) --i;  // a zero-width interval is never chosen (u < 1 guards the end)
-      start[c] = i;
-    }
-    vk::uploadBuffer(m_ctx, *m_start, start.data(), std::uint64_t(m_chains) * 4);
-    g.chunkPaths = m_chains;
-    g.primaryFresh = PRIMARY_FRESH_NONE;  // MLT_KERNEL_START stores the starts' draws
-    m_globals.upload();
-    traceBetween(MLT_KERNEL_START, MLT_KERNEL_ADOPT, m_chains);
-  }
+  m_report.b = startChains(f, seed, 0u, 0u);
+  for (float fi : f) m_report.nonzeroBootstrap += fi > 0.0f ? 1 : 0;
   // Kelemen's weights need b', an estimate of b independent of the chains' starts (the weights are
   // then a fixed function on the chain's space and the estimate stays unbiased; b itself from the
   // same pool as the starts keeps E[b h(X_0)] = the integral of f h): one more chunk of independent
@@ -165,14 +153,79 @@ void MltIntegrator::bootstrap(std::uint32_t firstSample) {
     // Without light in that chunk there is no b' to weigh by: the plain splats (a choice made from
     // the chunk alone, so the estimate stays unbiased).
     if (m_report.bPrime > 0)
-      m.weights = {1.0f, static_cast<float>(1.0 / m_report.bPrime), static_cast<float>(1.0 / m_report.b),
-                   m_settings.mltLargeStep};
+      m.weights = {1.0f, static_cast<float>(1.0 / m_report.bPrime), 0.0f, m_settings.mltLargeStep};
   }
-  // Film value of a splat sum: b x pixels / (chains x steps) per unit, per iteration (the film
-  // divides by its count, the iterations).
-  m.params.z = static_cast<float>(m_report.b * double(m_pixels) / (double(m_chains) * m_settings.mltSteps) /
-                                  double(MLT_FIXED_SCALE));
+  setNormalisation(m_report.b);
   m_report.bootstrapSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double MltIntegrator::startChains(const std::vector<float>& f, std::uint32_t seed, std::uint32_t source,
+                                  std::uint32_t firstNumber) {
+  const std::uint32_t n = static_cast<std::uint32_t>(f.size());
+  // b and the cumulative sums in double, in pool order (deterministic).
+  std::vector<double> cdf(std::size_t(n) + 1, 0.0);
+  for (std::uint32_t i = 0; i < n; ++i) cdf[i + 1] = cdf[i] + std::max(0.0, double(f[i]));
+  const double total = cdf[n];
+  if (!(total > 0)) return 0.0;
+  // Stratified resampling: chain c starts at the pool path whose cdf interval holds (c + u) /
+  // chains of the total, u uniform (48 bits from a hash of (c, seed)). Chain c's start is drawn
+  // from its own stratum of the cdf; over the chains, whose mean is the image, the starts are
+  // in proportion to f_i, so E[b x mean over chains of h(X_0)] = E[(1/B) sum_i f_i h(x_i)] still,
+  // and each pool path starts within one chain of its expected count (independent draws
+  // scattered the counts multinomially).
+  std::vector<std::uint32_t> start(m_chains);
+  for (std::uint32_t c = 0; c < m_chains; ++c) {
+    const glm::uvec4 h = shared::pcg4d(glm::uvec4(c, seed, MLT_STREAM_START, 0x9e3779b9u));
+    const double u = (double(h.x >> 8) * 16777216.0 + double(h.y >> 8)) / 281474976710656.0;
+    const double target = (double(c) + u) / double(m_chains) * total;
+    auto it = std::upper_bound(cdf.begin() + 1, cdf.end(), target);
+    std::uint32_t i = static_cast<std::uint32_t>(std::min<std::ptrdiff_t>(it - cdf.begin() - 1, n - 1));
+    while (i > 0 && f[i] <= 0.0f) --i;  // a zero-width interval is never chosen (u < 1 guards the end)
+    start[c] = i;
+  }
+  vk::uploadBuffer(m_ctx, *m_start, start.data(), std::uint64_t(m_chains) * 4);
+  Globals& g = m_globals.host();
+  GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
+  m.restart.x = source;
+  m.restart.y = firstNumber;
+  g.chunkFirst = 0;
+  g.chunkPaths = m_chains;
+  g.passSamples = 1;
+  g.sampleIndex = 0;
+  g.radiancePart = chainPart();
+  g.primaryFresh = PRIMARY_FRESH_NONE;  // MLT_KERNEL_START stores the starts' draws
+  m_globals.upload();
+  traceBetween(MLT_KERNEL_START, MLT_KERNEL_ADOPT, m_chains);
+  // A start's path, re-traced from its vector, must be the pool's: the same f (a path is a
+  // function of its vector, whichever pass traced it). Counted for the tests.
+  std::vector<glm::vec4> state(m_chains);
+  vk::downloadBuffer(m_ctx, *m_state, state.data(), std::uint64_t(m_chains) * 16);
+  for (std::uint32_t c = 0; c < m_chains; ++c)
+    m_report.startMismatches += shared::luminance(glm::vec3(state[c])) != f[start[c]] ? 1 : 0;
+  return total / double(n);
+}
+
+void MltIntegrator::setNormalisation(double b) {
+  GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
+  m_b = b;
+  // Film value of a splat sum: b x pixels / (chains x steps) per unit, per iteration (the film
+  // divides by its count, the iterations); a large step's path as an independent sample: 1 / b.
+  m.params.z = static_cast<float>(b * double(m_pixels) / (double(m_chains) * m_settings.mltSteps) /
+                                  double(MLT_FIXED_SCALE));
+  m.weights.z = b > 0 ? static_cast<float>(1.0 / b) : 0.0f;
+}
+
+void MltIntegrator::restart(std::uint32_t firstNumber) {
+  GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
+  const std::uint32_t n = m.restart.w;
+  std::vector<float> f(n);
+  vk::downloadBuffer(m_ctx, *m_poolF, f.data(), std::uint64_t(n) * 4);
+  const std::uint32_t seed = shared::pcg4d(glm::uvec4(m_settings.seed, m.restart.y, MLT_STREAM_POOL, 0x27d4eb2fu)).x;
+  // The pool's paths are samples restart.y .. of every pixel: the starts' vectors are theirs.
+  const double b = startChains(f, seed, 1u, m.restart.y);
+  setNormalisation(b);
+  ++m_report.restarts;
+  m.restart.y = firstNumber;  // the next pool: the pass's samples from this iteration on
 }
 
 void MltIntegrator::traceBetween(std::uint32_t before, std::uint32_t after, std::uint32_t n) {
@@ -194,15 +247,23 @@ void MltIntegrator::readCounters() {
 }
 
 void MltIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t samples) {
-  if (!m_bootstrapped) bootstrap(sampleIndex);
   Globals& g = m_globals.host();
   GpuMlt& m = *static_cast<GpuMlt*>(m_mlt->mapped);
+  const std::uint32_t firstNumber = sampleIndex * m_settings.mltPassSpp;  // the pass's first sample in this call
+  if (!m_bootstrapped) {
+    bootstrap(sampleIndex);
+    // Restarts: the pass pool fills from this call's pass on (none without caustic light).
+    if (m_report.noCaustics) m.restart.w = 0;
+    m.restart.y = firstNumber;
+  } else if (m.restart.w != 0 && std::uint64_t(firstNumber - m.restart.y) * m_pixels >= m.restart.w) {
+    restart(firstNumber);
+  }
   g.radiancePart = chainPart();
   g.primaryFresh = PRIMARY_FRESH_MUTATE;  // a proposal stores only its moved draws
   g.chunkFirst = 0;
   g.chunkPaths = m_chains;
   g.passSamples = 1;
-  if (m_report.b > 0) {
+  if (m_b > 0) {
     // Every iteration moves each chain settings.mltSteps times, in one submission; step j of
     // iteration i is step i x mltSteps + j of the render (GpuMlt.info.z, which keys the step's
     // random numbers: MLT_KERNEL_ADVANCE counts it on the device between steps). The camera's

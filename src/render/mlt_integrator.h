@@ -33,6 +33,14 @@
 // - indirect (Mitsuba's pssmlt "directSamples"): the chains carry light after two or more
 //   scatterings; the pass direct light only (its paths end at their second vertex).
 // 0: the whole path contribution is the chains' f.
+//
+// Restarts (RenderSettings::mltRestart, caustic chains only): every mltRestart pass samples per
+// pixel, the chains start again from the pass's own paths of those samples, as from a bootstrap
+// pool (b from their f, stratified starts, each re-traced from the pass path's numbers). The pass
+// path's f is the caustic light it left to the chains, which the shade and escape stages keep in
+// its radiance's w (PRIMARY_SAMPLES only). Each run of the chains between starts is an unbiased
+// estimate on its own, as above; a chain held at a rare path holds it for one run, not the whole
+// render, and the starts come from many more paths than one pool (docs/mlt.md, "Restarts").
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -52,6 +60,8 @@ struct MltReport {
   std::uint64_t nonzeroBootstrap = 0;  // bootstrap paths with f > 0
   bool noCaustics = false;      // caustic chains in a scene without delta lobes: no bootstrap, chains idle
   double bootstrapSeconds = 0;  // wall time of the bootstrap (its paths, b, the chains' starts)
+  std::uint32_t restarts = 0;   // starts from the pass's paths (RenderSettings::mltRestart)
+  std::uint64_t startMismatches = 0;  // chain starts whose re-traced f differs from their pool path's (0)
   double acceptance() const { return proposals ? double(accepted) / double(proposals) : 0.0; }
 };
 
@@ -76,7 +86,7 @@ class MltIntegrator : public PrimarySampleIntegrator {
   static std::uint32_t pathSlotsFor(const RenderSettings& settings, std::uint64_t pixels);
   // Device bytes of the chains' state beyond the path tracer's.
   static std::uint64_t bytesFor(std::uint32_t chains, std::uint32_t slots, std::uint32_t dims, std::uint32_t bootstrap,
-                                std::uint64_t pixels);
+                                std::uint64_t pixels, std::uint32_t restartSpp = 0);
   // Mutations per chain per pass when RenderSettings::samplesPerPass is 0: about 2^18 paths per
   // pass (the path tracer's count on a CPU device: a time budget ends within a few seconds on
   // lavapipe), at least 1.
@@ -98,6 +108,17 @@ class MltIntegrator : public PrimarySampleIntegrator {
   // trace of their paths, then kernel `after` (the pool, the chains' starts, every step).
   void traceBetween(std::uint32_t before, std::uint32_t after, std::uint32_t n);
   void readCounters();
+  // Chain starts drawn from a pool's f (in pool order) by stratified resampling (hashes of
+  // `seed`), their paths traced (MLT_KERNEL_START from pool `source`: 0 the bootstrap's, 1 the
+  // pass's, whose first sample is `firstNumber`; then MLT_KERNEL_ADOPT). Returns the pool's mean f
+  // (b); 0 (no chain started) when every f is 0.
+  double startChains(const std::vector<float>& f, std::uint32_t seed, std::uint32_t source, std::uint32_t firstNumber);
+  // The splats' normalisation from b (GpuMlt.params.z, weights.z); b = 0: the chains idle.
+  void setNormalisation(double b);
+  // Restart (RenderSettings::mltRestart): the chains start again from the pass pool (the pass's
+  // samples since the last start, GpuMlt.restart), with b from it; the next pool begins at pass
+  // sample `firstNumber`.
+  void restart(std::uint32_t firstNumber);
   // The part of a path's radiance that is the chains' f (RADIANCE_*: all, or indirect light when
   // direct light is outside the chain).
   std::uint32_t chainPart() const;
@@ -108,12 +129,14 @@ class MltIntegrator : public PrimarySampleIntegrator {
 
   std::uint32_t m_chains = 0, m_dims = 0, m_poolSize = 0;
   bool m_bootstrapped = false;
+  double m_b = 0;  // the current starts' normalisation (the bootstrap's b, then each restart's)
   MltScene m_scene;
   MltReport m_report;
   std::vector<float> m_poolValues;
   vk::Buffer* m_mlt = nullptr;  // the GpuMlt (host visible)
   vk::Buffer* m_poolF = nullptr;
   vk::Buffer* m_start = nullptr;
+  vk::Buffer* m_state = nullptr;
   vk::Buffer* m_counters = nullptr;
   vk::Buffer* m_splats = nullptr;
 };

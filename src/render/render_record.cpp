@@ -139,6 +139,7 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
       meta.ints.push_back({"nusselt/mltKelemen", r.settings.mltKelemen ? 1 : 0});
       meta.ints.push_back({"nusselt/mltPassSpp", r.settings.mltPassSpp});
       meta.ints.push_back({"nusselt/mltSteps", r.settings.mltSteps});
+      meta.ints.push_back({"nusselt/mltRestart", mltRestartSpp(r.settings, std::uint64_t(r.settings.width) * r.settings.height)});
       if (r.settings.mltPassSpp) meta.strings.push_back({"nusselt/mltChainLight", mltChainLightName(r.settings.mltChainLight)});
     }
     if (r.settings.integrator == IntegratorKind::Vegas) {
@@ -237,6 +238,8 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
     // pass (all light in the chains).
     // Renders written before the key moved every chain once per iteration.
     r.settings.mltSteps = static_cast<std::uint32_t>(findInt(meta, "nusselt/mltSteps").value_or(1));
+    // Renders written before the key never restarted their chains.
+    r.settings.mltRestart = static_cast<std::uint32_t>(findInt(meta, "nusselt/mltRestart").value_or(0));
     const auto passSpp = findInt(meta, "nusselt/mltPassSpp");
     r.settings.mltPassSpp = static_cast<std::uint32_t>(passSpp ? *passSpp : findInt(meta, "nusselt/mltDirectSpp").value_or(0));
     const std::string chainLight = findString(meta, "nusselt/mltChainLight").value_or(passSpp ? "" : "indirect");

@@ -118,7 +118,8 @@ Renderer::Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& s
                                std::max<std::size_t>(scene.materials.size(), 1) * sizeof(shared::GpuMaterial) +
                                Film::bytesFor(pixels) +
                                PathIntegrator::bytesFor(capacity, MAX_MODEL_SLOTS, primaryDims) +
-                               (mlt ? MltIntegrator::bytesFor(settings.mltChains, capacity, primaryDims, mltBootstrapPaths(settings), pixels) : 0) +
+                               (mlt ? MltIntegrator::bytesFor(settings.mltChains, capacity, primaryDims, mltBootstrapPaths(settings), pixels,
+                                                                 mltRestartSpp(settings, pixels)) : 0) +
                                (vegas ? VegasIntegrator::bytesFor(settings) : 0) +
                                (settings.guiding ? DeviceGuide::bytesFor(settings.guideMemory, capacity, settings.maxDepth) : 0);
     const std::uint64_t have = vk::deviceLocalHeapSize(m_ctx);

@@ -124,6 +124,9 @@ inline bool parseMltChainLight(const std::string& name, std::uint32_t& part) {
   return true;
 }
 
+// RenderSettings::mltRestart: restart when a bootstrap pool's worth of pass paths is traced.
+inline constexpr std::uint32_t kMltRestartAuto = 0xffffffffu;
+
 struct RenderSettings {
   IntegratorKind integrator = IntegratorKind::Path;
   std::uint32_t width = 512;
@@ -242,6 +245,12 @@ struct RenderSettings {
   // Path-traced samples per pixel per iteration of the light outside the chains (`--mlt-pass-spp`,
   // formerly `--mlt-direct-spp`); 0: the chains carry all light (docs/mlt.md).
   std::uint32_t mltPassSpp = 1;
+  // Restarts (`--mlt-restart`, docs/mlt.md "Restarts"): the caustic chains start again, from the
+  // pass's own paths (with mltPassSpp > 0), whenever the pass has traced this many samples of every
+  // pixel since their last start: b and the starts from those paths, as the bootstrap's from its
+  // pool. 0: never (the chains run from their bootstrap starts to the end); kMltRestartAuto (the
+  // default): mltRestartSpp.
+  std::uint32_t mltRestart = kMltRestartAuto;
   // VEGAS (--integrator vegas, docs/vegas.md). Bins per warped axis (`--vegas-bins`, 1 .. 4096).
   std::uint32_t vegasBins = 64;
   // Bounces whose light choice, light point and BSDF draws are warped (`--vegas-bounces`, 1 ..
@@ -252,10 +261,21 @@ struct RenderSettings {
   float vegasAlpha = 0.2f;
 };
 
+// RenderSettings::mltRestart resolved for an image of `pixels`: auto restarts caustic chains
+// (beside a pass) after as many pass samples per pixel as make a bootstrap pool (mltBootstrapPaths,
+// rounded up to whole samples of every pixel), and never restarts other chains.
+inline std::uint32_t mltRestartSpp(const RenderSettings& s, std::uint64_t pixels);
+
 // The bootstrap paths of a Metropolis render (RenderSettings::mltBootstrap resolved).
 inline std::uint32_t mltBootstrapPaths(const RenderSettings& s) {
   return s.mltBootstrap ? s.mltBootstrap
                         : static_cast<std::uint32_t>(std::min<std::uint64_t>(std::max<std::uint64_t>(16ull * s.mltChains, 1u << 21), 1u << 30));
+}
+
+inline std::uint32_t mltRestartSpp(const RenderSettings& s, std::uint64_t pixels) {
+  if (s.mltRestart != kMltRestartAuto) return s.mltRestart;
+  if (!s.mltPassSpp || s.mltChainLight != RADIANCE_CAUSTIC || pixels == 0) return 0;
+  return static_cast<std::uint32_t>(std::max<std::uint64_t>(1, (mltBootstrapPaths(s) + pixels - 1) / pixels));
 }
 
 // The training samples per pixel of a guided render: settings.guideTrainSpp, or when 0 the

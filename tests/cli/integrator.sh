@@ -58,6 +58,13 @@ for other in "--mlt-direct-spp 0" "--mlt-pass-spp 2" "--mlt-chain-light indirect
 done
 expect_error mlt_chain_light "--mlt-chain-light" -- --integrator mlt --mlt-chain-light direct
 expect_error mlt_steps "--mlt-steps" -- --integrator mlt --mlt-steps 0
+# Restarts: auto resolves to a bootstrap pool's worth of samples per pixel (2^21 / 64 pixels); a
+# word that is none of auto, off or a number, and restarts of chains without a caustic pass, are
+# refused.
+[ "$("$nusselt" info "$work/mlt.exr" | sed -n 's/^  nusselt\/mltRestart: //p')" = 32768 ] || fail "mlt header: mltRestart"
+expect_error mlt_restart_word "--mlt-restart often" -- --integrator mlt --mlt-restart often
+expect_error mlt_restart_negative "--mlt-restart -3" -- --integrator mlt --mlt-restart -3
+expect_error mlt_restart_indirect "--mlt-restart needs" -- --integrator mlt --mlt-chain-light indirect --mlt-restart 4
 "$nusselt" render "${small[@]}" --integrator mlt --mlt-chains 1024 --resume "$work/resume.exr" --spp 4 \
   || fail "mlt resume"
 [ "$("$nusselt" info "$work/resume.exr" | sed -n 's/^  nusselt\/spp: //p')" = 4 ] || fail "mlt resume: spp in the header"

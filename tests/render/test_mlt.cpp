@@ -172,6 +172,33 @@ TEST(Mlt, CausticChainsMatchThePathTracer) {
   expectMltMatchesPath(glassBox(), ms, 10, 1u << 16);
 }
 
+// Restarts (docs/mlt.md, "Restarts"): the caustic chains start again every iteration from the
+// pass's paths of the iteration before (64 per pixel: 16384 paths, as the restart's pool), with b
+// from them. Each epoch's chains are then an unbiased estimate on their own, so the image must
+// still be the path tracer's; and a start re-traced from its pass path's numbers must be that
+// path: the same f for every chain of every restart.
+TEST(Mlt, RestartedCausticChainsMatchThePathTracer) {
+  RenderSettings ms = base(0);
+  ms.integrator = IntegratorKind::Mlt;
+  ms.mltChains = 1024;
+  ms.mltSteps = 4;
+  ms.spp = 10;
+  ms.samplesPerPass = 1;
+  ms.mltPassSpp = 64;
+  ms.mltRestart = 64;
+  ms.mltBootstrap = 1u << 20;
+  {
+    Scene scene = glassBox();
+    Renderer r(test::context(), scene, ms);
+    r.render(ms.spp);
+    const MltReport& m = r.mlt()->report();
+    EXPECT_EQ(m.restarts, 9u);
+    EXPECT_EQ(m.startMismatches, 0u);
+    EXPECT_GT(m.proposals, 0u);
+  }
+  expectMltMatchesPath(glassBox(), ms, 10, 1u << 16);
+}
+
 // Caustic chains in a scene without delta lobes: no path carries caustic light, so the chains stay
 // idle (no bootstrap, no mutation) and the path-traced pass is the whole render. It draws the path
 // tracer's own numbers of each pixel and sample, so the image is the path tracer's up to rounding
