@@ -437,8 +437,8 @@ layout(buffer_reference, std430, buffer_reference_align = 16) buffer Mlts { GpuM
 // high word), read and emptied by the host after each pass.
 struct GpuVegas {
   uvec4 info;
-  // (the table's epoch: tables learned so far, 0 while the table is the uniform one; 1 when the
-  // warped axes' numbers are rotated, vegasRotation; 0, 0).
+  // (tables learned so far; where this pass's warped numbers come from, VEGAS_NUMBERS_* in
+  // vegas.h; 1 while the table is still learned, 0 when it is frozen; 0).
   uvec4 epoch;
   BUFREF(Floats) cdf;
   BUFREF(Uints) sums;

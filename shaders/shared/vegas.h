@@ -61,22 +61,25 @@ SHARED_FN uint vegasAxisOf(uint dimension, uint c, uint bounces) {
 // warped one (the others hash as the path tracer's).
 SHARED_FN uint vegasPrimaryDims(uint bounces) { return rngDimension(bounces - 1u, RNG_DIM_BSDF) + 1u; }
 
-// The rotation of a warped axis's number (component c of draw `dimension`) in a pass whose table
-// was learned from earlier passes (epoch > 0): the path tracer's QMC points of one pixel are
-// stratified against each other, so a pass's points depend on the earlier passes' points, and so
-// on the table learned from them; then E[f / p] given the table is not the integral (measured in
-// the furnace: +0.28 %, IntegratorFurnace.Vegas). A uniform shift per pass, pixel and axis,
-// hashed (independent of every earlier number), makes each warped number uniform and
-// independent of the table, and keeps the pass's own stratification (u + s mod 1).
-#define VEGAS_STREAM_ROTATE 0x766eu
-SHARED_FN float vegasRotation(uint pixel, uint epoch, uint dimension, uint c, uint seed) {
-  uvec4 h = pcg4d(uvec4(pixel, epoch, dimension * 2u + c, seed ^ (VEGAS_STREAM_ROTATE << 16u)));
-  return float(h.x >> 8u) * (1.0f / 16777216.0f);
-}
-SHARED_FN float vegasRotate(float u, float s) {
-  float x = u + s;
-  x = x - floor(x);
-  return x < 1.0f ? x : 0.0f;
+// Where a pass's warped numbers come from (GpuVegas.epoch.y). The table a pass warps with was
+// learned from earlier passes; the path tracer's QMC points of a pixel are stratified against
+// each other, so numbers from the same sequence would depend on the points the table was learned
+// from, and E[f / p] given the table would not be the integral (measured in the white furnace:
+// +0.28 %, IntegratorFurnace.Vegas). RENDER: the render's own numbers (the first pass, whose table
+// is uniform, and alpha 1: the path tracer's numbers bit for bit). LEARN: a pass whose table was
+// learned and may still change: independent hashes (the PCG sampler's numbers in a stream of their
+// own), which nothing before can know. FROZEN: the table no longer changes (--vegas-learn tables
+// learned): the render's sampler (QMC by default) with a seed of its own, whose scramble no earlier
+// number shares (the first pass used the render's seed, every other pass hashes), so a frozen
+// table's passes keep the QMC sequence's stratification over the rest of the render.
+#define VEGAS_NUMBERS_RENDER 0u
+#define VEGAS_NUMBERS_LEARN 1u
+#define VEGAS_NUMBERS_FROZEN 2u
+#define VEGAS_STREAM_NUMBERS 0x766eu
+SHARED_FN vec2 vegasNumbers(uint source, uint mode, uint pixel, uint sampleIndex, uint dimension, uint seed) {
+  uint s = seed ^ (VEGAS_STREAM_NUMBERS << 16u) ^ (source << 8u);
+  return source == VEGAS_NUMBERS_LEARN ? rng2(pixel, sampleIndex, dimension, s)
+                                       : sample2(mode, pixel, sampleIndex, dimension, source == VEGAS_NUMBERS_FROZEN ? s : seed);
 }
 // The bin of x in [0, 1) among n equal bins.
 SHARED_FN uint vegasBin(float x, uint n) { return min(uint(x * float(n)), n - 1u); }

@@ -31,12 +31,14 @@ void main() {
     for (uint d = 0u; d < dims; ++d) {
       // The path tracer's own number of this draw (pathSample2 without primary samples).
       vec2 u = sample2(g.rngMode, pixel, sampleIndex, d, g.seed);
+      // A warped draw's numbers: from the source the pass's table allows (vegasNumbers).
+      bool warped = vegasAxisOf(d, 0u, bounces) != 0xffffffffu || vegasAxisOf(d, 1u, bounces) != 0xffffffffu;
+      if (warped && V.epoch.y != VEGAS_NUMBERS_RENDER) u = vegasNumbers(V.epoch.y, g.rngMode, pixel, sampleIndex, d, g.seed);
       for (uint c = 0u; c < 2u; ++c) {
         uint a = vegasAxisOf(d, c, bounces);
         if (a == 0xffffffffu) continue;
         float pdf;
         uint bin;
-        if (V.epoch.y != 0u) u[c] = vegasRotate(u[c], vegasRotation(pixel, V.epoch.x, d, c, g.seed));
         u[c] = vegasWarp(cdf, a * (bins + 1u), bins, u[c], pdf, bin);
       }
       primary.v[primarySampleIndex(i, d, dims)] = u;
@@ -54,7 +56,7 @@ void main() {
     // Non-finite radiance: the accumulate stage drops and counts it; it teaches nothing here.
     if (!(isFinite(L.x) && isFinite(L.y) && isFinite(L.z))) return;
     float F = max(luminance(L), 0.0f);
-    if (!(F > 0.0f)) return;
+    if (!(F > 0.0f) || V.epoch.z == 0u) return;  // nothing to learn, or the table is frozen
     Uints sums = V.sums;
     for (uint a = 0u; a < axes; ++a) {
       float x = primary.v[primarySampleIndex(i, vegasAxisDimension(a), dims)][vegasAxisComponent(a)];

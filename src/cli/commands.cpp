@@ -70,6 +70,7 @@ struct RenderArgs {
   std::uint32_t vegasBins = 64;
   std::uint32_t vegasBounces = 1;
   float vegasAlpha = 0.2f;
+  std::uint32_t vegasLearn = RenderSettings{}.vegasLearn;
   std::string guiding = "off";
   std::uint32_t guideTrain = 0;
   double guideMemoryMiB = 16;
@@ -152,6 +153,7 @@ int renderCommand(const RenderArgs& a) {
   s.vegasBins = a.vegasBins;
   s.vegasBounces = a.vegasBounces;
   s.vegasAlpha = a.vegasAlpha;
+  s.vegasLearn = a.vegasLearn;
   s.guiding = a.guiding == "on";
   s.guideTrainSpp = a.guideTrain;
   s.guideSpatialThreshold = a.guideSpatial;
@@ -924,6 +926,10 @@ int runCli(int argc, char** argv) {
   render->add_option("--vegas-alpha", ra.vegasAlpha, "vegas: share of the uniform density in each learned one "
                                                      "(0.01 .. 1; keeps every bin's density >= alpha)")
       ->capture_default_str();
+  render->add_option("--vegas-learn", ra.vegasLearn, "vegas: tables learned, one after each pass; then the table is "
+                                                     "frozen and the rest of the render samples it with the render's "
+                                                     "own (QMC) numbers (docs/vegas.md)")
+      ->capture_default_str()->check(CLI::Range(1u, 1000000u));
   render->add_option("--guiding", ra.guiding, "Path guiding (docs/guiding.md): on = sample directions from a guide "
                                               "learned from the render's first samples (one-sample MIS with the BSDF "
                                               "sampler), off = BSDF sampling only")

@@ -146,6 +146,7 @@ ImageMetadata makeMetadata(const RenderRecord& r) {
       meta.ints.push_back({"nusselt/vegasBins", r.settings.vegasBins});
       meta.ints.push_back({"nusselt/vegasBounces", r.settings.vegasBounces});
       meta.doubles.push_back({"nusselt/vegasAlpha", r.settings.vegasAlpha});
+      meta.ints.push_back({"nusselt/vegasLearn", r.settings.vegasLearn});
     }
     const bool mlt = r.settings.integrator == IntegratorKind::Mlt;
     for (auto& [name, value] : meta.strings)
@@ -250,6 +251,8 @@ RenderRecord readRecord(const std::string& path, const ImageMetadata& meta) {
     r.settings.vegasBins = static_cast<std::uint32_t>(findInt(meta, "nusselt/vegasBins").value_or(64));
     r.settings.vegasBounces = static_cast<std::uint32_t>(findInt(meta, "nusselt/vegasBounces").value_or(1));
     r.settings.vegasAlpha = static_cast<float>(findDouble(meta, "nusselt/vegasAlpha").value_or(0.2));
+    // Renders written before the key learned a table after every pass.
+    r.settings.vegasLearn = static_cast<std::uint32_t>(findInt(meta, "nusselt/vegasLearn").value_or(0xffffffff));
   }
   // Absent in unguided renders (and files written before guiding existed).
   r.settings.guiding = findString(meta, "nusselt/guiding").value_or("off") == "on";

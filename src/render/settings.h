@@ -259,6 +259,10 @@ struct RenderSettings {
   // Weight of the uniform density in every learned one (`--vegas-alpha`, 0.01 .. 1; 1: no warp):
   // every bin keeps a density >= alpha, so the estimate stays unbiased and 1 / p_a <= 1 / alpha.
   float vegasAlpha = 0.2f;
+  // Tables learned (`--vegas-learn`, one after each pass; at least 1): then the table is frozen,
+  // and the warped numbers of the later passes come from the render's sampler again (vegas.h,
+  // vegasNumbers: while it learns, they are hashes). docs/vegas.md.
+  std::uint32_t vegasLearn = 8;
 };
 
 // RenderSettings::mltRestart resolved for an image of `pixels`: auto restarts caustic chains

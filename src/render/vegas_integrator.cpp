@@ -83,6 +83,7 @@ VegasIntegrator::VegasIntegrator(vk::Context& ctx, StageGlobals& globals, const 
   GpuVegas& v = *static_cast<GpuVegas*>(m_vegas->mapped);
   v = GpuVegas{};
   v.info = {m_axes, m_bins, dims, settings.vegasBounces};
+  v.epoch = {0u, VEGAS_NUMBERS_RENDER, settings.vegasLearn > 0 ? 1u : 0u, 0u};
   v.cdf = m_cdf->address;
   v.sums = m_sums->address;
   globals.host().vegas = m_vegas->address;
@@ -119,7 +120,7 @@ void VegasIntegrator::renderPass(std::uint32_t sampleIndex, std::uint32_t sample
     m_paths->recordAccumulate(cmd, count);
     submit();
   }
-  learn(paths);
+  if (m_report.refinements < m_settings.vegasLearn) learn(paths);
 }
 
 void VegasIntegrator::learn(std::uint64_t paths) {
@@ -140,11 +141,15 @@ void VegasIntegrator::learn(std::uint64_t paths) {
   }
   std::memset(sums, 0, std::size_t(m_axes) * m_bins * 8);
   ++m_report.refinements;
-  // The next pass's table depends on this pass's numbers: its warped numbers are rotated
-  // (vegasRotation), unless no table ever leaves the uniform one (alpha 1: no adaptation, the
-  // path tracer's numbers bit for bit).
+  // The next pass warps with a table learned from this pass's numbers: its warped numbers come from
+  // a source none of them shares (vegasNumbers), hashes while the table is learned, the render's
+  // sampler with a seed of its own once it is frozen; with alpha 1 no table leaves the uniform one
+  // (the path tracer's numbers bit for bit).
+  const bool learning = m_report.refinements < m_settings.vegasLearn;
   GpuVegas& v = *static_cast<GpuVegas*>(m_vegas->mapped);
-  v.epoch = {m_report.refinements, m_settings.vegasAlpha < 1.0f ? 1u : 0u, 0u, 0u};
+  v.epoch = {m_report.refinements,
+             m_settings.vegasAlpha >= 1.0f ? VEGAS_NUMBERS_RENDER : (learning ? VEGAS_NUMBERS_LEARN : VEGAS_NUMBERS_FROZEN),
+             learning ? 1u : 0u, 0u};
   m_report.learnedPaths += paths;
   m_report.learnSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
