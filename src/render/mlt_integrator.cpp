@@ -14,9 +14,6 @@ namespace nusselt {
 using shared::GpuMlt;
 using shared::Globals;
 
-namespace {
-constexpr std::uint64_t kMaxRestartPaths = 1ull << 26;  // 256 MiB of f values
-}
 
 std::uint64_t MltIntegrator::bytesFor(std::uint32_t chains, std::uint32_t slots, std::uint32_t dims,
                                       std::uint32_t bootstrap, std::uint64_t pixels, std::uint32_t restartSpp) {
@@ -52,7 +49,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   // The restart pool: mltRestart samples of every pixel (whole sweeps, so that its paths cover the
   // image evenly: the pool's mean is then an unbiased b).
   const std::uint64_t restartPaths = std::uint64_t(restartSpp) * pixels;
-  if (restartPaths > kMaxRestartPaths)
+  if (restartPaths > kMltMaxRestartPaths)
     throw Error("mlt: --mlt-restart " + std::to_string(restartSpp) + " x " + std::to_string(pixels) +
                 " pixels is a pool of more than 2^26 paths; give fewer samples per pixel");
   m_report.chains = m_chains;

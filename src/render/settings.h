@@ -126,6 +126,8 @@ inline bool parseMltChainLight(const std::string& name, std::uint32_t& part) {
 
 // RenderSettings::mltRestart: restart when a bootstrap pool's worth of pass paths is traced.
 inline constexpr std::uint32_t kMltRestartAuto = 0xffffffffu;
+// The largest restart pool (paths: samples x pixels; 256 MiB of f values).
+inline constexpr std::uint64_t kMltMaxRestartPaths = 1ull << 26;
 
 struct RenderSettings {
   IntegratorKind integrator = IntegratorKind::Path;
@@ -267,7 +269,8 @@ struct RenderSettings {
 
 // RenderSettings::mltRestart resolved for an image of `pixels`: auto restarts caustic chains
 // (beside a pass) after as many pass samples per pixel as make a bootstrap pool (mltBootstrapPaths,
-// rounded up to whole samples of every pixel), and never restarts other chains.
+// rounded up to whole samples of every pixel; at most kMltMaxRestartPaths paths), and never restarts
+// other chains, nor any in an image whose single sample of every pixel would be a larger pool.
 inline std::uint32_t mltRestartSpp(const RenderSettings& s, std::uint64_t pixels);
 
 // The bootstrap paths of a Metropolis render (RenderSettings::mltBootstrap resolved).
@@ -278,8 +281,9 @@ inline std::uint32_t mltBootstrapPaths(const RenderSettings& s) {
 
 inline std::uint32_t mltRestartSpp(const RenderSettings& s, std::uint64_t pixels) {
   if (s.mltRestart != kMltRestartAuto) return s.mltRestart;
-  if (!s.mltPassSpp || s.mltChainLight != RADIANCE_CAUSTIC || pixels == 0) return 0;
-  return static_cast<std::uint32_t>(std::max<std::uint64_t>(1, (mltBootstrapPaths(s) + pixels - 1) / pixels));
+  if (!s.mltPassSpp || s.mltChainLight != RADIANCE_CAUSTIC || pixels == 0 || pixels > kMltMaxRestartPaths) return 0;
+  const std::uint64_t spp = std::max<std::uint64_t>(1, (mltBootstrapPaths(s) + pixels - 1) / pixels);
+  return static_cast<std::uint32_t>(std::min<std::uint64_t>(spp, kMltMaxRestartPaths / pixels));
 }
 
 // The training samples per pixel of a guided render: settings.guideTrainSpp, or when 0 the

@@ -75,3 +75,24 @@ TEST(Settings, CountersAreOneList) {
   EXPECT_TRUE(visited.count("rays") && visited.count("samplerBoundViolations"));
   EXPECT_EQ(sum, 18u);
 }
+
+// --mlt-restart auto (docs/mlt.md, "Restarts"): a bootstrap pool's worth of samples per pixel,
+// rounded up, capped at kMltMaxRestartPaths paths; off for chains without a caustic pass and for
+// images whose single sample of every pixel is a larger pool; an explicit value as given.
+TEST(Settings, MltRestartAutoResolves) {
+  RenderSettings s;
+  EXPECT_EQ(mltRestartSpp(s, 256ull * 256), 32u);       // 2^21 / 2^16
+  EXPECT_EQ(mltRestartSpp(s, 100ull * 100), 210u);      // ceil(2097152 / 10000)
+  EXPECT_EQ(mltRestartSpp(s, 4096ull * 4096), 1u);      // at least one sample
+  EXPECT_EQ(mltRestartSpp(s, (1ull << 26) + 1), 0u);    // one sample is too large a pool
+  s.mltBootstrap = 1u << 30;
+  EXPECT_EQ(mltRestartSpp(s, 256ull * 256), 1024u);     // capped: 2^26 / 2^16
+  s.mltBootstrap = 0;
+  s.mltChainLight = RADIANCE_INDIRECT;
+  EXPECT_EQ(mltRestartSpp(s, 256ull * 256), 0u);
+  s.mltChainLight = RADIANCE_CAUSTIC;
+  s.mltPassSpp = 0;
+  EXPECT_EQ(mltRestartSpp(s, 256ull * 256), 0u);
+  s.mltRestart = 7;
+  EXPECT_EQ(mltRestartSpp(s, 256ull * 256), 7u);        // explicit: the integrator refuses it without a pass
+}
