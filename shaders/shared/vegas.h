@@ -76,10 +76,10 @@ SHARED_FN uint vegasPrimaryDims(uint bounces) { return rngDimension(bounces - 1u
 #define VEGAS_NUMBERS_LEARN 1u
 #define VEGAS_NUMBERS_FROZEN 2u
 #define VEGAS_STREAM_NUMBERS 0x766eu
+// The numbers of a LEARN or FROZEN pass (a RENDER pass keeps the render's own: vegas.comp).
 SHARED_FN vec2 vegasNumbers(uint source, uint mode, uint pixel, uint sampleIndex, uint dimension, uint seed) {
   uint s = seed ^ (VEGAS_STREAM_NUMBERS << 16u) ^ (source << 8u);
-  return source == VEGAS_NUMBERS_LEARN ? rng2(pixel, sampleIndex, dimension, s)
-                                       : sample2(mode, pixel, sampleIndex, dimension, source == VEGAS_NUMBERS_FROZEN ? s : seed);
+  return source == VEGAS_NUMBERS_LEARN ? rng2(pixel, sampleIndex, dimension, s) : sample2(mode, pixel, sampleIndex, dimension, s);
 }
 // The bin of x in [0, 1) among n equal bins.
 SHARED_FN uint vegasBin(float x, uint n) { return min(uint(x * float(n)), n - 1u); }

@@ -60,7 +60,6 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   // The chains' second vector buffer (the first is the path tracer's primarySamples).
   vk::Buffer* vectorsB = make(std::uint64_t(shared::primarySampleSlots(m_chains)) * m_dims * 8, "mlt vectors");
   m_state = make(std::uint64_t(m_chains) * 16, "mlt chain states");
-  vk::Buffer* state = m_state;
   m_splats = make(m_pixels * 24, "mlt splats");
   m_poolF = make(std::max<std::uint64_t>(std::uint64_t(m_poolSize) + m_paths->capacity(), restartPaths) * 4,
                  "mlt bootstrap");
@@ -75,7 +74,7 @@ MltIntegrator::MltIntegrator(vk::Context& ctx, StageGlobals& globals, const Rend
   m.pool = {0u, 0u, m_poolSize, settings.seed};
   m.params = {settings.mltLargeStep, settings.mltSigma, 0.0f, 0.0f};
   m.vectorsB = vectorsB->address;
-  m.state = state->address;
+  m.state = m_state->address;
   m.splats = m_splats->address;
   m.poolF = m_poolF->address;
   m.start = m_start->address;
