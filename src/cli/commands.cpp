@@ -506,7 +506,7 @@ struct BenchArgs {
   std::uint32_t repeats = 1;
   std::string guiding = "off";
   std::uint32_t guideTrain = 15;
-  std::string guideAlpha = "0.5";
+  std::string guideAlpha = "auto";  // what render --guiding on samples (until 2026-12-07: 0.5)
   EnvironmentArgs env;
 };
 
