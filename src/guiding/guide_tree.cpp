@@ -69,6 +69,54 @@ void DirTree::splatBoxInto(std::uint32_t node, double x0, double y0, double size
   }
 }
 
+double DirTree::pdfWithout(glm::vec2 p, glm::vec2 q, double side, double value) const {
+  // The splat's share of a cell [x0, x0 + s) x [y0, y0 + s): splatBox's arithmetic.
+  const double h = 0.5 * side;
+  const double bx0 = std::max(0.0, double(q.x) - h), bx1 = std::min(1.0, double(q.x) + h);
+  const double width = bx1 - bx0;
+  const double perArea = width > 0 && side > 0 ? value / (width * side) : 0.0;
+  auto share = [&](double x0, double y0, double s) {
+    if (!(perArea > 0)) {  // a point splat
+      return (q.x >= x0 && q.x < x0 + s && q.y >= y0 && q.y < y0 + s) ? value : 0.0;
+    }
+    const double ox = std::min(bx1, x0 + s) - std::max(bx0, x0);
+    if (!(ox > 0)) return 0.0;
+    double oy = 0;
+    for (double shift : {-1.0, 0.0, 1.0}) {
+      const double a = double(q.y) - h + shift, b = double(q.y) + h + shift;
+      const double o = std::min(b, y0 + s) - std::max(a, y0);
+      if (o > 0) oy += o;
+    }
+    return perArea * ox * oy;
+  };
+  double pdf = 1.0;
+  std::uint32_t node = 0;
+  double x0 = 0, y0 = 0, size = 1;
+  for (std::uint32_t d = 0; d <= GUIDE_MAX_DIR_DEPTH; ++d) {
+    const Node& N = m_nodes[node];
+    const double all = N.energy[0] + N.energy[1] + N.energy[2] + N.energy[3];
+    const double T = all - share(x0, y0, size);
+    size *= 0.5;
+    std::uint32_t c = 0;
+    if (p.x >= x0 + size) {
+      c += 1;
+      x0 += size;
+    }
+    if (p.y >= y0 + size) {
+      c += 2;
+      y0 += size;
+    }
+    const double e = N.energy[c] - share(x0, y0, size);
+    // What the splat alone held is 0 up to rounding: no energy left.
+    const double eps = 1e-12 * all;
+    if (!(T > eps) || !(e > eps)) return 0.0;
+    pdf *= 4.0 * e / T;
+    if (N.child[c] == 0) break;
+    node = N.child[c];
+  }
+  return pdf;
+}
+
 double DirTree::total() const {
   const Node& r = m_nodes[0];
   return r.energy[0] + r.energy[1] + r.energy[2] + r.energy[3];
@@ -258,17 +306,82 @@ void GuideTree::observeSelection(std::uint32_t leafIndex, double y, double pdfGu
   }
 }
 
+void GuideTree::observeSelectionAt(std::uint32_t leafIndex, glm::vec3 d, double value, double y, double pdfGuide,
+                                   double pdfBsdf, double alpha) {
+  if (!leaveOneOut()) {
+    observeSelection(leafIndex, y, pdfGuide, pdfBsdf, alpha);
+    return;
+  }
+  const double pMix = alpha * pdfGuide + (1.0 - alpha) * pdfBsdf;
+  if (!(pMix > 0) || !std::isfinite(pMix) || !(pdfGuide >= 0) || !(pdfBsdf >= 0) || !std::isfinite(y)) return;
+  Leaf& l = m_leaves[leafIndex];
+  if (l.keepSeen++ % l.keepStride != 0) return;
+  // A contribution without the BRDF sampler's density is a rounding case (observeSelection): it
+  // counts as a vertex whose estimate is 0 under every alpha.
+  const bool counts = y > 0 && pdfBsdf > 0;
+  const shared::vec2 q = shared::guideDirectionToSquare(shared::vec3(d.x, d.y, d.z));
+  l.kept.push_back({glm::vec2(q.x, q.y), value > 0 && std::isfinite(value) ? value : 0.0, float(counts ? y : 0.0), float(pMix),
+                    float(pdfBsdf)});
+  if (l.kept.size() >= 2 * std::size_t(std::max(1u, m_settings.alphaKeep))) {
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < l.kept.size(); k += 2) l.kept[n++] = l.kept[k];
+    l.kept.resize(n);
+    l.keepStride *= 2;
+  }
+}
+
+// Leave-one-out scoring (GuideSettings::alphaLeaveOneOut): each kept vertex's d_c with the density
+// of this iteration's tree without its own splat, the tree the alpha will sample. The leaves are
+// independent: scored on every core, each leaf's sums in its vertices' order (deterministic).
+void GuideTree::scoreKept() {
+  const unsigned t = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), leafCount()));
+  auto body = [&](unsigned i) {
+    for (std::size_t li = i; li < m_leaves.size(); li += t) {
+      Leaf& l = m_leaves[li];
+      SelectionStats& st = l.selection;
+      const DirTree& tree = l.building;
+      const double F = m_settings.floor;
+      for (const Leaf::Kept& k : l.kept) {
+        st.vertices += 1;
+        if (!(k.y > 0)) continue;
+        const double side = m_settings.dirFilter ? tree.leafSide(k.p) : 0.0;
+        const double pg = ((1.0 - F) * tree.pdfWithout(k.p, k.p, side, k.value) + F) * NUSSELT_INV_4PI;
+        const double w = double(k.y) * k.y * k.pMix;
+        for (std::size_t c = 1; c < kAlphaCandidates.size(); ++c) {
+          const double a = kAlphaCandidates[c];
+          const double pc = a * pg + (1.0 - a) * k.pBsdf;  // > 0: pBsdf > 0 and a < 1
+          const double dd = w * (1.0 / k.pBsdf - 1.0 / pc);
+          st.gain[c] += dd;
+          st.gainSq[c] += dd * dd;
+        }
+      }
+      l.scoredLeaveOneOut = !l.kept.empty();
+      l.kept.clear();
+      l.kept.shrink_to_fit();
+      l.keepSeen = 0;
+      l.keepStride = 1;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned i = 1; i < t; ++i) pool.emplace_back(body, i);
+  body(0u);
+  for (std::thread& th : pool) th.join();
+}
+
 // At the end of an iteration, for each leaf whose guide had mass (else its samples say nothing
-// about a guide) and that saw at least alphaMinVertices vertices: the candidate with the largest
+// about a guide: with leave-one-out the guide the alpha will sample, else the one the vertices
+// were drawn with) and that saw at least alphaMinVertices vertices: the candidate with the largest
 // estimated gain (the smallest second moment) is taken when its gain is significant (z-test of the
 // mean of the d_c: mean / standard error > alphaZ), else alpha = 0 (BRDF sampling alone: where the
 // guide does not pay, it is not used). Other leaves keep their alpha.
 void GuideTree::learnAlphas() {
+  if (leaveOneOut()) scoreKept();
   for (Leaf& l : m_leaves) {
     SelectionStats& st = l.selection;
     if (m_settings.alpha >= 0) {
       l.alpha = m_settings.alpha;
-    } else if (l.sampling.total() > 0 && st.vertices >= m_settings.alphaMinVertices) {
+    } else if ((l.scoredLeaveOneOut ? l.building.total() : l.sampling.total()) > 0 &&
+               st.vertices >= m_settings.alphaMinVertices) {
       std::size_t best = 1;
       for (std::size_t c = 2; c < kAlphaCandidates.size(); ++c)
         if (st.gain[c] > st.gain[best]) best = c;
@@ -280,6 +393,7 @@ void GuideTree::learnAlphas() {
       l.alphaVertices = n;
     }
     st = SelectionStats{};
+    l.scoredLeaveOneOut = false;
   }
 }
 
@@ -455,7 +569,7 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
       const std::uint32_t leaf = tree.findLeaf(glm::vec3(a), o);
       tree.splatAt(leaf, glm::vec3(a), o, glm::vec3(b), after / double(b.w));
       // The same radiance is the vertex's estimate through its sample (y = F / p_mix).
-      if (c.x >= 0.0f) tree.observeSelection(leaf, after, c.x, c.y, c.z);
+      if (c.x >= 0.0f) tree.observeSelectionAt(leaf, glm::vec3(b), after / double(b.w), after, c.x, c.y, c.z);
       ++splats;
     });
     return splats;
@@ -500,7 +614,7 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
       const std::uint32_t leaf = leafOf[std::size_t(p) * perPath + k];
       if (owner[leaf] != i) return;
       tree.splatInLeaf(leaf, glm::vec3(b), after / double(b.w));
-      if (c.x >= 0.0f) tree.observeSelection(leaf, after, c.x, c.y, c.z);
+      if (c.x >= 0.0f) tree.observeSelectionAt(leaf, glm::vec3(b), after / double(b.w), after, c.x, c.y, c.z);
       ++splats[i];
     });
   });

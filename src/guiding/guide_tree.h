@@ -64,6 +64,17 @@ struct GuideSettings {
   // (3.09: significance 0.001 per candidate, at most 12 x 0.001 over the candidates).
   double alphaMinVertices = 64;
   double alphaZ = 3.09;
+  // Score the candidates against the guide the alpha will sample (this iteration's tree), each
+  // vertex with its own splat taken out of it (leave-one-out: the tree was trained on the very
+  // vertices that score it), instead of against the guide the vertices were drawn with (the
+  // previous iteration's, trained on half the paths). Not with the spatial filter (a splat then
+  // reaches other regions' trees): there the drawn-with guide scores. docs/guiding.md, "Where the
+  // learned alpha falls back".
+  bool alphaLeaveOneOut = true;
+  // Leave-one-out: vertices kept per region and iteration at most (a systematic sample of the
+  // region's vertices in path order: past 2 x alphaKeep, every other one is dropped and the
+  // stride doubles), bounding the memory (32 bytes each) and the scoring's time.
+  std::uint32_t alphaKeep = 16384;
   // Directional splat filter (docs/guiding.md, "Splat filtering"): each splat is spread over a
   // box of the map the size of the building tree's leaf cell it lands in, centred on its point
   // (wrapping around in phi, clipped at the poles' edges and renormalised), its value shared among
@@ -117,6 +128,10 @@ class DirTree {
   const std::vector<Node>& nodes() const { return m_nodes; }
   // Depth of the deepest leaf cell (the root's children are at depth 1).
   std::uint32_t depth() const;
+  // Density per unit area of the map at p (as guideSquarePdf on the flattened tree, in double)
+  // of this tree with one splatBox(q, side, value) taken out (splat(q, value) for side 0): the
+  // leave-one-out density of the learned alpha. 0 where the rest has no energy.
+  double pdfWithout(glm::vec2 p, glm::vec2 q, double side, double value) const;
 
  private:
   // The descent to p's leaf, the same cell geometry as guideSquarePdf (dyadic, exact in floats):
@@ -202,6 +217,11 @@ class GuideTree {
   // radiance it carried, >= 0), pdfGuide and pdfBsdf = the guide's and the BRDF sampler's
   // densities at the sampled direction, alpha = the selection probability it was drawn with.
   void observeSelection(std::uint32_t leaf, double y, double pdfGuide, double pdfBsdf, double alpha);
+  // The same for a vertex whose sample, in direction d, splatted `value` into the leaf's building
+  // tree: with settings.alphaLeaveOneOut kept, to be scored at the iteration's end against that
+  // tree without its own splat; else observeSelection.
+  void observeSelectionAt(std::uint32_t leaf, glm::vec3 d, double value, double y, double pdfGuide, double pdfBsdf,
+                          double alpha);
   // The end of training iteration `iteration` (0, 1, ...): build, refine, report.
   IterationReport endIteration(std::uint32_t iteration);
 
@@ -244,9 +264,22 @@ class GuideTree {
     float alpha = 0;  // learned: 0 until the region's guide proves itself
     double alphaVertices = 0;
     SelectionStats selection;
+    // Leave-one-out (GuideSettings::alphaLeaveOneOut): the iteration's kept vertices, 1 in
+    // keepStride of those seen (keepSeen).
+    struct Kept {
+      glm::vec2 p;     // the sampled direction's map point
+      double value;    // its splat's value (exactly what the tree received: taken out again)
+      float y;         // its estimate y (0: nothing came back)
+      float pMix, pBsdf;  // the densities it was drawn with (mixture) and of the BRDF sampler
+    };
+    std::vector<Kept> kept;
+    std::uint64_t keepSeen = 0, keepStride = 1;
+    bool scoredLeaveOneOut = false;  // this iteration's stats score the building tree (scoreKept)
     std::uint32_t orientation = 0;  // the orientation class whose root it descends from
   };
   void learnAlphas();
+  void scoreKept();
+  bool leaveOneOut() const { return m_settings.alphaLeaveOneOut && !m_settings.spatialFilter && m_settings.alpha < 0; }
   // value into leaf's building tree at direction d (its directional filter if set).
   void splatDirection(std::uint32_t leaf, glm::vec3 d, double value);
   // The spatial node (a leaf) whose box holds x under the root of orientation class o.

@@ -459,6 +459,63 @@ DirTree uniformDepth2() {
 double overlap(double a0, double a1, double b0, double b1) { return std::max(0.0, std::min(a1, b1) - std::max(a0, b0)); }
 }  // namespace
 
+// The leave-one-out density of the learned alpha (DirTree::pdfWithout): a tree of many cell sizes
+// with 300 splats, one of them taken out, has at every point the density of the same structure
+// trained on the other 299 (a density computed by the same descent without taking anything out),
+// for box splats (points at the poles and the phi seam among them) and point splats.
+TEST(Guiding, LeaveOneOutDensityEqualsTheTreeTrainedWithoutThatSplat) {
+  GuideTree trained = trainedTree(3, 12, 50000);
+  const DirTree zero = trained.buildingTree(0);  // the refined structure, energies 0
+  ASSERT_GT(zero.depth(), 6u);
+  std::mt19937 rng(29);
+  std::uniform_real_distribution<float> U(0.0f, 1.0f);
+  struct Splat {
+    glm::vec2 q;
+    double value;
+  };
+  std::vector<Splat> splats;
+  for (int i = 0; i < 300; ++i) {
+    glm::vec2 q(U(rng), U(rng));
+    if (i % 5 == 1) q.x = 1e-4f * U(rng);         // at the pole u = 0
+    if (i % 5 == 2) q.y = 1.0f - 1e-4f * U(rng);  // at the phi seam
+    if (i % 5 == 3) q = glm::vec2(0.3f, 0.7f) + 0.01f * glm::vec2(U(rng), U(rng));  // a lobe
+    splats.push_back({glm::min(q, glm::vec2(NUSSELT_ONE_MINUS_EPS)), std::exp(4.0 * U(rng))});
+  }
+  for (bool box : {true, false}) {
+    auto train = [&](int skip) {
+      DirTree t = zero;
+      for (int i = 0; i < int(splats.size()); ++i)
+        if (i != skip) {
+          if (box) t.splatBox(splats[i].q, t.leafSide(splats[i].q), splats[i].value);
+          else t.splat(splats[i].q, splats[i].value);
+        }
+      return t;
+    };
+    const DirTree all = train(-1);
+    double worst = 0;
+    int positive = 0, compared = 0;
+    for (int j = 0; j < int(splats.size()); j += 7) {
+      const DirTree without = train(j);
+      const glm::vec2 q = splats[j].q;
+      const double side = box ? all.leafSide(q) : 0.0;
+      for (int k = 0; k < 200; ++k) {
+        // Points near the splat (its own cells) and anywhere.
+        glm::vec2 p = k % 2 ? glm::vec2(U(rng), U(rng)) : q + float(side + 1e-3) * glm::vec2(U(rng) - 0.5f, U(rng) - 0.5f);
+        p = glm::clamp(p, glm::vec2(0.0f), glm::vec2(NUSSELT_ONE_MINUS_EPS));
+        const double want = without.pdfWithout(p, p, 0.0, 0.0);
+        const double got = all.pdfWithout(p, q, side, splats[j].value);
+        worst = std::max(worst, std::abs(got - want) / std::max(1.0, want));
+        positive += want > 0;
+        ++compared;
+      }
+    }
+    std::printf("leave-one-out (%s splats): %d points (%d with density), largest error %.3g\n", box ? "box" : "point",
+                compared, positive, worst);
+    EXPECT_LT(worst, 1e-9) << (box ? "box" : "point");
+    EXPECT_GT(positive, compared / 4);
+  }
+}
+
 // The box filter of a directional splat: the box of the side of the cell the point lands in,
 // centred on it, shares the value among the overlapped leaf cells by area (wrapping around in phi,
 // cut at u = 0 and 1 and renormalised): on the 4 x 4 tree each cell's energy is value x its
