@@ -17,11 +17,11 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 // ---- Directional quadtree -------------------------------------------------------------------------
 
 void DirTree::splat(glm::vec2 p, double value) {
-  descend(p, [&](std::uint32_t node, std::uint32_t c) { m_nodes[node].energy[c] += value; });
+  descend(p, [&](std::uint32_t node, std::uint32_t c, float, float, float) { m_nodes[node].energy[c] += value; });
 }
 
 double DirTree::leafSide(glm::vec2 p) const {
-  return descend(p, [](std::uint32_t, std::uint32_t) {});
+  return descend(p, [](std::uint32_t, std::uint32_t, float, float, float) {});
 }
 
 void DirTree::splatBox(glm::vec2 p, double side, double value) {
@@ -90,31 +90,20 @@ double DirTree::pdfWithout(glm::vec2 p, glm::vec2 q, double side, double value) 
     return perArea * ox * oy;
   };
   double pdf = 1.0;
-  std::uint32_t node = 0;
-  double x0 = 0, y0 = 0, size = 1;
-  for (std::uint32_t d = 0; d <= GUIDE_MAX_DIR_DEPTH; ++d) {
+  bool empty = false;
+  descend(p, [&](std::uint32_t node, std::uint32_t c, float cx0, float cy0, float side) {
+    if (empty) return;
     const Node& N = m_nodes[node];
     const double all = N.energy[0] + N.energy[1] + N.energy[2] + N.energy[3];
-    const double T = all - share(x0, y0, size);
-    size *= 0.5;
-    std::uint32_t c = 0;
-    if (p.x >= x0 + size) {
-      c += 1;
-      x0 += size;
-    }
-    if (p.y >= y0 + size) {
-      c += 2;
-      y0 += size;
-    }
-    const double e = N.energy[c] - share(x0, y0, size);
+    const double px0 = cx0 - ((c & 1u) ? side : 0.0f), py0 = cy0 - ((c & 2u) ? side : 0.0f);  // the node's cell
+    const double T = all - share(px0, py0, 2.0 * side);
+    const double e = N.energy[c] - share(cx0, cy0, side);
     // What the splat alone held is 0 up to rounding: no energy left.
     const double eps = 1e-12 * all;
-    if (!(T > eps) || !(e > eps)) return 0.0;
-    pdf *= 4.0 * e / T;
-    if (N.child[c] == 0) break;
-    node = N.child[c];
-  }
-  return pdf;
+    if (!(T > eps) || !(e > eps)) empty = true;
+    else pdf *= 4.0 * e / T;
+  });
+  return empty ? 0.0 : pdf;
 }
 
 double DirTree::total() const {

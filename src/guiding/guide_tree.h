@@ -135,7 +135,8 @@ class DirTree {
 
  private:
   // The descent to p's leaf, the same cell geometry as guideSquarePdf (dyadic, exact in floats):
-  // visit(node, child) at every level, the leaf's last; returns the leaf cell's side.
+  // visit(node, child, the child cell's corner x0, y0 and side) at every level, the leaf's last;
+  // returns the leaf cell's side.
   template <class Visit>
   double descend(glm::vec2 p, Visit&& visit) const {
     std::uint32_t node = 0;
@@ -151,7 +152,7 @@ class DirTree {
         c += 2;
         y0 += size;
       }
-      visit(node, c);
+      visit(node, c, x0, y0, size);
       if (m_nodes[node].child[c] == 0) break;
       node = m_nodes[node].child[c];
     }
