@@ -184,6 +184,7 @@ GuideTree::GuideTree(glm::vec3 lo, glm::vec3 hi, const GuideSettings& settings) 
     leaf.orientation = o;
     m_leaves.push_back(leaf);
   }
+  m_keepCap = keepCap();
 }
 
 std::uint32_t GuideTree::findLeaf(glm::vec3 x, std::uint32_t o) const { return m_nodes[findNode(x, o)].leaf; }
@@ -311,12 +312,24 @@ void GuideTree::observeSelectionAt(std::uint32_t leafIndex, glm::vec3 d, double 
   const shared::vec2 q = shared::guideDirectionToSquare(shared::vec3(d.x, d.y, d.z));
   l.kept.push_back({glm::vec2(q.x, q.y), value > 0 && std::isfinite(value) ? value : 0.0, float(counts ? y : 0.0), float(pMix),
                     float(pdfBsdf)});
-  if (l.kept.size() >= 2 * std::size_t(std::max(1u, m_settings.alphaKeep))) {
+  if (l.kept.size() >= 2 * std::size_t(m_keepCap)) {
     std::size_t n = 0;
     for (std::size_t k = 0; k < l.kept.size(); k += 2) l.kept[n++] = l.kept[k];
     l.kept.resize(n);
     l.keepStride *= 2;
   }
+}
+
+std::uint32_t GuideTree::keepCap() const {
+  const std::uint64_t share = m_settings.alphaKeptTotal / std::max<std::uint64_t>(1, m_leaves.size());
+  const std::uint64_t cap = std::max<std::uint64_t>(m_settings.alphaKeepMin, std::min<std::uint64_t>(m_settings.alphaKeep, share));
+  return static_cast<std::uint32_t>(std::max<std::uint64_t>(1, cap));
+}
+
+std::uint64_t GuideTree::keptVertices() const {
+  std::uint64_t n = 0;
+  for (const Leaf& l : m_leaves) n += l.kept.size();
+  return n;
 }
 
 // Leave-one-out scoring (GuideSettings::alphaLeaveOneOut): each kept vertex's d_c with the density
@@ -469,6 +482,7 @@ IterationReport GuideTree::endIteration(std::uint32_t iteration) {
     m_leaves[l].samples = 0;
   }
 
+  m_keepCap = keepCap();  // for the next iteration's regions
   rep.leaves = leafCount();
   for (const Leaf& l : m_leaves) rep.dirNodes += l.sampling.nodeCount();
   rep.bytes = bytes();

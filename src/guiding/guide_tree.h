@@ -72,9 +72,14 @@ struct GuideSettings {
   // learned alpha falls back".
   bool alphaLeaveOneOut = true;
   // Leave-one-out: vertices kept per region and iteration at most (a systematic sample of the
-  // region's vertices in path order: past 2 x alphaKeep, every other one is dropped and the
-  // stride doubles), bounding the memory (32 bytes each) and the scoring's time.
+  // region's vertices in path order: past twice the cap, every other one is dropped and the
+  // stride doubles), bounding the memory (32 bytes each) and the scoring's time. The cap is
+  // alphaKeep, lowered to alphaKeptTotal / regions (not below alphaKeepMin) when there are many
+  // regions: the kept vertices never exceed 2 x max(alphaKeptTotal, alphaKeepMin x regions)
+  // (256 MiB by default, and 64 KiB per region beyond 4096 regions).
   std::uint32_t alphaKeep = 16384;
+  std::uint64_t alphaKeptTotal = 1ull << 22;
+  std::uint32_t alphaKeepMin = 1024;
   // Directional splat filter (docs/guiding.md, "Splat filtering"): each splat is spread over a
   // box of the map the size of the building tree's leaf cell it lands in, centred on its point
   // (wrapping around in phi, clipped at the poles' edges and renormalised), its value shared among
@@ -243,6 +248,8 @@ class GuideTree {
   float leafAlpha(std::uint32_t leaf) const { return m_leaves[leaf].alpha; }
   double leafAlphaVertices(std::uint32_t leaf) const { return m_leaves[leaf].alphaVertices; }
   const SelectionStats& leafSelection(std::uint32_t leaf) const { return m_leaves[leaf].selection; }
+  // Vertices kept for the leave-one-out scoring so far in this iteration, over all regions.
+  std::uint64_t keptVertices() const;
   // The orientation class of the leaf's vertices (its root's).
   std::uint32_t leafOrientation(std::uint32_t leaf) const { return m_leaves[leaf].orientation; }
   // The leaf's box.
@@ -281,6 +288,8 @@ class GuideTree {
   void learnAlphas();
   void scoreKept();
   bool leaveOneOut() const { return m_settings.alphaLeaveOneOut && !m_settings.spatialFilter && m_settings.alpha < 0; }
+  // The per-region cap of kept vertices for the current number of regions (GuideSettings::alphaKeep).
+  std::uint32_t keepCap() const;
   // value into leaf's building tree at direction d (its directional filter if set).
   void splatDirection(std::uint32_t leaf, glm::vec3 d, double value);
   // The spatial node (a leaf) whose box holds x under the root of orientation class o.
@@ -293,6 +302,7 @@ class GuideTree {
   std::vector<SpatialNode> m_nodes;
   std::vector<Leaf> m_leaves;
   std::uint64_t m_splats = 0;
+  std::uint32_t m_keepCap = 1;  // keepCap() for this iteration's regions
 };
 
 // Splats the training records of a chunk of `paths` paths (guiding_layout.h: recordsPerPath records

@@ -516,6 +516,38 @@ TEST(Guiding, LeaveOneOutDensityEqualsTheTreeTrainedWithoutThatSplat) {
   }
 }
 
+// The leave-one-out scoring keeps a bounded, systematic sample of a region's vertices: with a cap
+// of 100, 10000 vertices leave between 100 and 200 (every stride-th in order, the stride a power
+// of two), which is what the learned alpha's count says it saw; the cap falls to
+// alphaKeptTotal / regions with many regions, not below alphaKeepMin.
+TEST(Guiding, LeaveOneOutKeepsABoundedSampleOfTheVertices) {
+  GuideSettings s;
+  s.orientations = 1;
+  s.alphaKeep = 100;
+  s.alphaKeptTotal = 1000;
+  s.alphaKeepMin = 10;
+  s.alphaMinVertices = 1;
+  GuideTree t(glm::vec3(0.0f), glm::vec3(1.0f), s);
+  for (int i = 0; i < 1000; ++i) t.splat(glm::vec3(0.5f), 0, glm::vec3(0, 0, 1), 1.0);
+  t.endIteration(0);  // a tree with mass
+  ASSERT_EQ(t.leafCount(), 1u);
+  for (int i = 0; i < 10000; ++i) t.observeSelectionAt(0, glm::vec3(0, 0, 1), 1.0, 1.0, 0.1, 0.1, 0.0);
+  const std::uint64_t kept = t.keptVertices();
+  EXPECT_GE(kept, 100u);
+  EXPECT_LT(kept, 200u);
+  EXPECT_EQ(kept, (10000u + 63u) / 64u) << "every 64th of 10000 (stride doubled six times past 200)";
+  for (int i = 0; i < 1000; ++i) t.splat(glm::vec3(0.5f), 0, glm::vec3(0, 0, 1), 1.0);  // the tree they score
+  t.endIteration(1);
+  EXPECT_EQ(t.keptVertices(), 0u);
+  EXPECT_EQ(t.leafAlphaVertices(0), double(kept));
+  // Many regions: 1000 / regions, not below 10.
+  s.alphaKeptTotal = 64;
+  GuideTree u(glm::vec3(0.0f), glm::vec3(1.0f), s);
+  for (int i = 0; i < 10000; ++i) u.observeSelectionAt(0, glm::vec3(0, 0, 1), 1.0, 1.0, 0.1, 0.1, 0.0);
+  EXPECT_LT(u.keptVertices(), 2u * 64u);
+  EXPECT_GE(u.keptVertices(), 64u);
+}
+
 // The box filter of a directional splat: the box of the side of the cell the point lands in,
 // centred on it, shares the value among the overlapped leaf cells by area (wrapping around in phi,
 // cut at u = 0 and 1 and renormalised): on the 4 x 4 tree each cell's energy is value x its
