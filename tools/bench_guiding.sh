@@ -23,6 +23,11 @@
 #   main's: "|@/tmp/nusselt-old" compares the two interleaved).
 # Besides the medians, the means of relMSE over the seeds with their standard errors (the error
 # of a guided render is heavy-tailed: a few paths through a poorly learned cell).
+# The reference is rendered with --variance, so `nusselt diff` also gives each run's relMSE less the
+# reference's own noise (its var channels: for a run independent of it, E[relMSE] = the run's
+# error + the reference's); printed beside the raw figure, with the ratios of both. The noise of a
+# 4096-spp reference is a few % of a 10 s unguided run's relMSE, a larger share of a guided run's:
+# the raw ratios understate the gains (and the losses).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=${1:-/tmp/nusselt-bench-guiding}
@@ -78,9 +83,9 @@ echo "device: $("$bin" devices | head -1)"
 for scene in $scenes; do
   name=$(scene_name "$scene")
   sceneArg=$(scene_arg "$scene")
-  ref="$dir/$name-ref-$size-$refSpp-$depth.exr"
+  ref="$dir/$name-ref-$size-$refSpp-$depth-var.exr"
   # shellcheck disable=SC2086
-  bench_reference "$bin" "$scene" "$ref" "$refSpp" $common
+  bench_reference "$bin" "$scene" "$ref" "$refSpp" $common --variance
   for mode in "${modes[@]}"; do : > "$dir/$name.$mode"; done
   # One untimed render per mode first: lavapipe compiles a pipeline at its first dispatch (Mesa's
   # disk cache keeps it for later processes), which would otherwise land in the first round's
@@ -99,12 +104,15 @@ for scene in $scenes; do
       "$run" render $sceneArg $common --spp "$spp" ${budget:+--time "$budget"} --seed "$r" --guiding "$guiding" $extra -o "$out"
       t1=$(date +%s.%N)
       sec=$(echo "$t1 - $t0" | bc -l)
-      rel=$("$bin" diff "$out" "$ref" | awk '{print $2}')
+      d=$("$bin" diff "$out" "$ref")
+      rel=$(echo "$d" | awk 'NR == 1 {print $2}')
+      net=$(echo "$d" | awk 'NR == 2 {print $NF}')  # less the reference's noise
+      [ -n "$net" ] || net=$rel
       prod=$(calc "$rel * $sec")
       got=$("$bin" info "$out" | awk '$1 == "nusselt/spp:" {print $2}')
-      printf "%-20s guiding %-3s seed %d: relMSE %.5g  %.2f s  relMSE x s %.5g  %s spp  (load %s)\n" "$name" "$mode" "$r" \
-        "$rel" "$sec" "$prod" "$got" "$(cut -d' ' -f1 /proc/loadavg)"
-      echo "$rel $sec $prod $got" >> "$dir/$name.$mode"
+      printf "%-20s guiding %-3s seed %d: relMSE %.5g (less the reference's noise %.5g)  %.2f s  relMSE x s %.5g  %s spp  (load %s)\n" \
+        "$name" "$mode" "$r" "$rel" "$net" "$sec" "$prod" "$got" "$(cut -d' ' -f1 /proc/loadavg)"
+      echo "$rel $sec $prod $got $net" >> "$dir/$name.$mode"
     done
   done
   for mode in "${modes[@]}"; do
@@ -112,9 +120,15 @@ for scene in $scenes; do
     ms=$(awk '{print $2}' "$dir/$name.$mode" | median)
     mp=$(awk '{print $3}' "$dir/$name.$mode" | median)
     mg=$(awk '{print $4}' "$dir/$name.$mode" | median)
-    printf "%-20s guiding %-3s median: relMSE %.5g  %.2f s  relMSE x s %.5g  %s spp\n" "$name" "$mode" "$mr" "$ms" "$mp" "$mg"
+    mn=$(awk '{print $5}' "$dir/$name.$mode" | median)
+    printf "%-20s guiding %-3s median: relMSE %.5g (less the reference's noise %.5g)  %.2f s  relMSE x s %.5g  %s spp\n" \
+      "$name" "$mode" "$mr" "$mn" "$ms" "$mp" "$mg"
     read -r mm se < <(awk '{print $1}' "$dir/$name.$mode" | mean_se)
-    printf "%-20s guiding %-3s mean:   relMSE %.5g +- %.2g\n" "$name" "$mode" "$mm" "$se"
+    read -r nm nse < <(awk '{print $5}' "$dir/$name.$mode" | mean_se)
+    printf "%-20s guiding %-3s mean:   relMSE %.5g +- %.2g (less the reference's noise %.5g +- %.2g)\n" "$name" "$mode" \
+      "$mm" "$se" "$nm" "$nse"
+    eval "n_$mode=$mn"
+    eval "nm_$mode=$nm"
     eval "m_$mode=$mm"
     eval "p_$mode=$mp"
     eval "r_$mode=$mr"
@@ -123,7 +137,11 @@ for scene in $scenes; do
     rOn=r_$mode
     pOn=p_$mode
     mOn=m_$mode
+    nOn=n_$mode
+    nmOn=nm_$mode
     printf "%-20s unguided / guided %s: relMSE %.3fx, relMSE x time %.3fx, means %.3fx (> 1: guiding wins)\n" "$name" "$mode" \
       "$(calc "$r_off / ${!rOn}")" "$(calc "$p_off / ${!pOn}")" "$(calc "$m_off / ${!mOn}")"
+    printf "%-20s   less the reference's noise: relMSE %.3fx, means %.3fx\n" "$name" \
+      "$(calc "$n_off / ${!nOn}")" "$(calc "$nm_off / ${!nmOn}")"
   done
 done

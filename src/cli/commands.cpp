@@ -721,6 +721,10 @@ int diffCommand(const std::string& a, const std::string& b, const std::string& r
   ImageDifference d = compareImages(ia, ib);
   std::printf("relMSE %.6g  MSE %.6g  mean %.6g (%s) vs %.6g (%s)  max |diff| %.6g\n", d.relMse, d.mse, d.meanA,
               a.c_str(), d.meanB, b.c_str(), d.maxAbs);
+  // A second line only where the reference has variance channels (scripts read the first).
+  if (d.referenceRelMse >= 0)
+    std::printf("relMSE less the reference's own %.6g (its var channels; for an image independent of it): %.6g\n",
+                d.referenceRelMse, d.relMse - d.referenceRelMse);
   if (!mapPath.empty()) writePng(mapPath, errorMap(ia, ib));
   return kExitOk;
 }
@@ -1040,7 +1044,7 @@ int runCli(int argc, char** argv) {
   CLI::App* info = app.add_subcommand("info", "Print the size, mean and header attributes of OpenEXR images");
   info->add_option("files", infoFiles, "EXR files")->required();
   std::string diffA, diffB;
-  CLI::App* diff = app.add_subcommand("diff", "Compare two EXR images: relMSE (reference = second), MSE, means, max difference");
+  CLI::App* diff = app.add_subcommand("diff", "Compare two EXR images: relMSE (reference = second), MSE, means, max difference; with a reference that has var channels (render --variance), also the relMSE less the reference's own noise");
   diff->add_option("image", diffA, "Image")->required();
   diff->add_option("reference", diffB, "Reference image")->required();
   std::string diffRegion;

@@ -523,6 +523,14 @@ ImageDifference compareImages(const Image& a, const Image& reference) {
   d.meanA = sumA / double(n);
   d.meanB = sumB / double(n);
   d.maxAbs = nan ? std::numeric_limits<double>::quiet_NaN() : maxAbs;
+  if (reference.variance.size() == n) {
+    double refSum = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const double r = reference.rgb[i];
+      refSum += double(reference.variance[i]) / (r * r + 0.01);
+    }
+    d.referenceRelMse = refSum / double(n);
+  }
   return d;
 }
 
@@ -540,9 +548,14 @@ Image cropImage(const Image& image, double x0, double y0, double x1, double y1, 
   out.width = px1 - px0;
   out.height = py1 - py0;
   out.rgb.reserve(std::size_t(3) * out.width * out.height);
+  const bool variance = image.variance.size() == image.rgb.size();  // kept: diff --region uses it
   for (int y = py0; y < py1; ++y)
     for (int x = px0; x < px1; ++x)
-      for (int c = 0; c < 3; ++c) out.rgb.push_back(image.rgb[(std::size_t(y) * image.width + x) * 3 + c]);
+      for (int c = 0; c < 3; ++c) {
+        const std::size_t i = (std::size_t(y) * image.width + x) * 3 + c;
+        out.rgb.push_back(image.rgb[i]);
+        if (variance) out.variance.push_back(image.variance[i]);
+      }
   return out;
 }
 

@@ -77,12 +77,19 @@ uint8_t toSrgb8(float linear);
 void writePng(const std::string& path, const Image& image, float exposureStops = 0.0f);
 
 // Error metrics between an image and a reference of equal size (throws nusselt::Error on a size
-// mismatch). Means are over all pixels and all three channels; variance is ignored.
+// mismatch). Means are over all pixels and all three channels; the image's variance is ignored,
+// the reference's gives referenceRelMse.
 struct ImageDifference {
   double relMse = 0;  // mean of (x - ref)^2 / (ref^2 + 0.01)
   double mse = 0;     // mean of (x - ref)^2
   double meanA = 0, meanB = 0;  // mean of all channels of a and of reference
   double maxAbs = 0;  // max |x - ref|; NaN if any difference is NaN
+  // The reference's own noise, where it carries the variance of its mean (var channels: `render
+  // --variance`): the mean of var / (ref^2 + 0.01) over the same values as relMse; -1 without.
+  // For an image independent of the reference (another seed), E[(x - ref)^2] = E[(x - truth)^2] +
+  // var(ref): relMse - referenceRelMse estimates the image's relMSE against the truth (up to the
+  // noise of ref^2 in the denominator, of relative order var / ref^2).
+  double referenceRelMse = -1;
 };
 ImageDifference compareImages(const Image& a, const Image& reference);
 // A map of where the error is (`nusselt diff --map`): each pixel grey at its relative RMS error
@@ -94,6 +101,7 @@ Image errorMap(const Image& a, const Image& reference);
 // height (0 <= x0 < x1 <= 1, likewise y; at least one pixel): a region of interest that means the
 // same part of the picture at any resolution (`nusselt diff --region`). Throws nusselt::Error on
 // fractions out of range or in the wrong order; `what` names them in the message.
+// Variance channels, where the image has them, are cropped alike.
 Image cropImage(const Image& image, double x0, double y0, double x1, double y1, const std::string& what = "region");
 
 }  // namespace nusselt

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -437,6 +438,65 @@ TEST(ImageCompare, KnownInputs) {
   Image broken = ref;
   broken.rgb.pop_back();
   errorOf([&] { compareImages(a, broken); });
+}
+
+// The reference's own noise (`nusselt diff` with a reference rendered with --variance): its share
+// of relMse, and the crop keeping the variance channels.
+TEST(ImageCompare, ReferenceVarianceGivesItsOwnShareOfRelMse) {
+  Image a, ref;
+  a.width = ref.width = 2;
+  a.height = ref.height = 1;
+  a.rgb = {1, 2, 3, 0, 0, 0};
+  ref.rgb = {1, 1, 1, 0, 0, 1};
+  EXPECT_EQ(compareImages(a, ref).referenceRelMse, -1.0);  // no variance channels
+  ref.variance = {0.5f, 0, 0, 0.25f, 0, 0};
+  EXPECT_DOUBLE_EQ(compareImages(a, ref).referenceRelMse, (0.5 / 1.01 + 0.25 / 0.01) / 6);
+  EXPECT_EQ(compareImages(ref, a).referenceRelMse, -1.0);  // only the reference's variance counts
+  Image right = cropImage(ref, 0.5, 0.0, 1.0, 1.0);
+  ASSERT_EQ(right.variance.size(), 3u);
+  EXPECT_EQ(right.variance[0], 0.25f);
+}
+
+// relMse - referenceRelMse estimates the image's relMSE against the truth. Simulated: per value a
+// true mean m (0.02 .. 2.02), an image x = m + N(0, (0.1 m)^2) and an independent reference
+// r = m + N(0, (0.02 m)^2) carrying var = (0.02 m)^2; the image's true relMSE is
+// T = mean of (0.1 m)^2 / (m^2 + 0.01). The estimate must be within 4 standard errors of its
+// per-value terms (two-sided, about 6e-5) plus the bias of the noisy denominator, whose leading
+// term is below 3 var / m^2 = 0.0012 of T (0.002 T allowed); relMse alone is off by the
+// reference's noise, about 4 % of T, far outside the same bound.
+TEST(ImageCompare, RelMseLessTheReferenceNoiseIsUnbiased) {
+  const int pixels = 100000;
+  Image x, r;
+  x.width = r.width = pixels;
+  x.height = r.height = 1;
+  std::mt19937 rng(16);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::vector<double> m(std::size_t(3) * pixels);
+  double truth = 0;
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    m[i] = 0.02 + 2.0 * std::fmod(double(i) * 0.6180339887, 1.0);
+    const double sa = 0.1 * m[i], sb = 0.02 * m[i];
+    x.rgb.push_back(float(m[i] + sa * normal(rng)));
+    r.rgb.push_back(float(m[i] + sb * normal(rng)));
+    r.variance.push_back(float(sb * sb));
+    truth += sa * sa / (m[i] * m[i] + 0.01);
+  }
+  const double n = double(m.size());
+  truth /= n;
+  ImageDifference d = compareImages(x, r);
+  ASSERT_GT(d.referenceRelMse, 0.0);
+  const double estimate = d.relMse - d.referenceRelMse;
+  double sum = 0, sumSq = 0;
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    const double rr = r.rgb[i], diff = double(x.rgb[i]) - rr;
+    const double t = (diff * diff - double(r.variance[i])) / (rr * rr + 0.01);
+    sum += t;
+    sumSq += t * t;
+  }
+  const double se = std::sqrt(std::max(0.0, sumSq / n - (sum / n) * (sum / n)) / n);
+  const double bound = 4.0 * se + 0.002 * truth;
+  EXPECT_LT(std::abs(estimate - truth), bound) << "truth " << truth << ", estimate " << estimate << ", se " << se;
+  EXPECT_GT(std::abs(d.relMse - truth), bound) << "relMse " << d.relMse << ": the reference's noise should show";
 }
 
 TEST(ImageCompare, RegionCropsTheTouchedPixels) {
