@@ -23,11 +23,13 @@
 #   main's: "|@/tmp/nusselt-old" compares the two interleaved).
 # Besides the medians, the means of relMSE over the seeds with their standard errors (the error
 # of a guided render is heavy-tailed: a few paths through a poorly learned cell).
-# The reference is rendered with --variance, so `nusselt diff` also gives each run's relMSE less the
-# reference's own noise (its var channels: for a run independent of it, E[relMSE] = the run's
-# error + the reference's); printed beside the raw figure, with the ratios of both. The noise of a
-# 4096-spp reference is a few % of a 10 s unguided run's relMSE, a larger share of a guided run's:
-# the raw ratios understate the gains (and the losses).
+# The reference is rendered with --variance and independent random numbers (--rng pcg: its var
+# channels, the sample variance over n, are then its mean's variance; under the default quasi-Monte
+# Carlo numbers they would overstate it), so `nusselt diff` also gives each run's relMSE less the
+# reference's own noise (for a run independent of it, E[relMSE] = the run's error + the
+# reference's); printed beside the raw figure, with the ratios of both. The noise of a 4096-spp
+# reference is several % of a 10 s unguided run's relMSE and a larger share of a guided run's: the
+# raw ratios understate the gains (and the losses).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=${1:-/tmp/nusselt-bench-guiding}
@@ -54,7 +56,7 @@ IFS='|' read -r -a variants <<< "${VARIANTS:-}"
 modes=(off)
 for ((v = 0; v < ${#variants[@]}; v++)); do modes+=("on$v"); done
 if [ -n "$budget" ]; then per="$budget s of rendering per run (at most $spp spp)"; else per="$spp spp per run"; fi
-echo "bench_guiding: ${size}x${size}, $per, reference $refSpp spp (unguided), max depth $depth, $repeats repeats, guided with: --guiding on ${GUIDE_ARGS:-}"
+echo "bench_guiding: ${size}x${size}, $per, reference $refSpp spp (unguided, pcg), max depth $depth, $repeats repeats, guided with: --guiding on ${GUIDE_ARGS:-}"
 # A variant's binary ("@PATH " before its options) and its options.
 variant_bin() { local v=${variants[$1]}; if [[ $v == @* ]]; then v=${v%% *}; echo "${v#@}"; else echo "$bin"; fi; }
 variant_args() {
@@ -83,9 +85,9 @@ echo "device: $("$bin" devices | head -1)"
 for scene in $scenes; do
   name=$(scene_name "$scene")
   sceneArg=$(scene_arg "$scene")
-  ref="$dir/$name-ref-$size-$refSpp-$depth-var.exr"
+  ref="$dir/$name-ref-$size-$refSpp-$depth-pcg-var.exr"
   # shellcheck disable=SC2086
-  bench_reference "$bin" "$scene" "$ref" "$refSpp" $common --variance
+  bench_reference "$bin" "$scene" "$ref" "$refSpp" $common --rng pcg --variance
   for mode in "${modes[@]}"; do : > "$dir/$name.$mode"; done
   # One untimed render per mode first: lavapipe compiles a pipeline at its first dispatch (Mesa's
   # disk cache keeps it for later processes), which would otherwise land in the first round's

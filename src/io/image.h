@@ -88,7 +88,9 @@ struct ImageDifference {
   // --variance`): the mean of var / (ref^2 + 0.01) over the same values as relMse; -1 without.
   // For an image independent of the reference (another seed), E[(x - ref)^2] = E[(x - truth)^2] +
   // var(ref): relMse - referenceRelMse estimates the image's relMSE against the truth (up to the
-  // noise of ref^2 in the denominator, of relative order var / ref^2).
+  // noise of ref^2 in the denominator, of relative order var / ref^2). The var channels are the
+  // sample variance over n: the mean's variance for independent samples (`render --rng pcg`);
+  // under quasi-Monte Carlo numbers (the default) they overstate it, and so does this.
   double referenceRelMse = -1;
 };
 ImageDifference compareImages(const Image& a, const Image& reference);
