@@ -110,6 +110,10 @@ for scene in $scenes; do
       rel=$(echo "$d" | awk 'NR == 1 {print $2}')
       net=$(echo "$d" | awk 'NR == 2 {print $NF}')  # less the reference's noise
       [ -n "$net" ] || net=$rel
+      if awk -v n="$net" 'BEGIN { exit !(n <= 0) }'; then
+        echo "warning: $out: its relMSE $rel is not above the reference's own noise (relMSE less it: $net):" \
+          "the figures less the reference's noise mean nothing here; render the reference with more REF_SPP" >&2
+      fi
       prod=$(calc "$rel * $sec")
       got=$("$bin" info "$out" | awk '$1 == "nusselt/spp:" {print $2}')
       printf "%-20s guiding %-3s seed %d: relMSE %.5g (less the reference's noise %.5g)  %.2f s  relMSE x s %.5g  %s spp  (load %s)\n" \
