@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Bit-identity check for refactors: renders a fixed set of small cases (every sampler, lighting
 # mode, random-number mode (the default qmc, and pcg) and roulette on the Cornell box; the
-# materials scene; the test scenes; combined materials; Metropolis and VEGAS; the dragon) and compares them with a
+# materials scene; the test scenes; combined materials; Metropolis and VEGAS; path guiding with
+# its defaults, its options and its photon pre-pass; the dragon) and compares them with a
 # recorded set. A refactor must leave
 # every pixel and every counter of the header unchanged.
 #
@@ -46,9 +47,13 @@ cases=(
   "cornell-mlt-direct-in-chain|$small --integrator mlt --mlt-chains 4096 --mlt-direct-spp 0 --mlt-weights plain"
   "glass-mlt|scenes/cornell/cornell-glass.glb $small --integrator mlt --mlt-chains 2048"
   "cornell-vegas|$small --integrator vegas"
+  "cornell-guided|$small --spp 8 --guiding on --guide-train 7"
+  "indirect-guided|scenes/cornell/cornell-indirect.glb $small --spp 8 --guiding on --guide-train 7"
+  "indirect-guided-options|scenes/cornell/cornell-indirect.glb $small --spp 8 --guiding on --guide-train 7 --guide-alpha 0.5 --guide-filter none --guide-spatial-filter box --guide-learn radiance --guide-floor 0.1"
+  "glass-guided-photons|scenes/cornell/cornell-glass.glb $small --spp 8 --guiding on --guide-train 7 --guide-photons 20000"
   "dragon|scenes/dragon/dragon.gltf --width 32 --height 32 --spp 2 --max-depth 4 -q --checkpoint 0"
 )
-counters='nusselt/(rays|shadowRays|nonFiniteSamples|bvhStackOverflows|samplerBoundViolations|samplerTrialFailures|spp):'
+counters='nusselt/(guideHash|rays|shadowRays|nonFiniteSamples|bvhStackOverflows|samplerBoundViolations|samplerTrialFailures|spp):'
 status=0
 for c in "${cases[@]}"; do
   name=${c%%|*}

@@ -24,31 +24,63 @@ double DirTree::leafSide(glm::vec2 p) const {
   return descend(p, [](std::uint32_t, std::uint32_t, float, float, float) {});
 }
 
+namespace {
+// The box of splatBox(p, side, value) on the map, for the splat and for pdfWithout alike: u (cos
+// theta, x) ends at the poles, so the box is cut there and its value renormalised to the rest;
+// phi (y) wraps around, so a box crossing y = 0 or 1 is two parts (side <= 1/2). point: no box
+// (side 0, or nothing left after the cut): splat(p, value).
+struct SplatBox {
+  bool point = true;
+  double x0 = 0, x1 = 0, perArea = 0;
+  int parts = 0;
+  std::array<double, 2> y0{}, y1{};
+  SplatBox(glm::vec2 p, double side, double value) {
+    const double h = 0.5 * side;
+    x0 = std::max(0.0, double(p.x) - h);
+    x1 = std::min(1.0, double(p.x) + h);
+    const double width = x1 - x0;
+    if (!(side > 0) || !(width > 0)) return;
+    point = false;
+    perArea = value / (width * side);
+    const double by0 = double(p.y) - h, by1 = double(p.y) + h;
+    if (by0 < 0.0) {
+      add(by0 + 1.0, 1.0);
+      add(0.0, by1);
+    } else if (by1 > 1.0) {
+      add(by0, 1.0);
+      add(0.0, by1 - 1.0);
+    } else {
+      add(by0, by1);
+    }
+  }
+  // The box's value within the cell [cx0, cx0 + s) x [cy0, cy0 + s) (a box, not a point).
+  double within(double cx0, double cy0, double s) const {
+    const double ox = std::min(x1, cx0 + s) - std::max(x0, cx0);
+    if (!(ox > 0)) return 0.0;
+    double oy = 0;
+    for (int i = 0; i < parts; ++i) {
+      const double o = std::min(y1[i], cy0 + s) - std::max(y0[i], cy0);
+      if (o > 0) oy += o;
+    }
+    return perArea * ox * oy;
+  }
+
+ private:
+  void add(double a, double b) {
+    y0[parts] = a;
+    y1[parts] = b;
+    ++parts;
+  }
+};
+}  // namespace
+
 void DirTree::splatBox(glm::vec2 p, double side, double value) {
-  if (!(side > 0)) {
+  const SplatBox box(p, side, value);
+  if (box.point) {
     splat(p, value);
     return;
   }
-  const double h = 0.5 * side;
-  // u (cos theta) ends at the poles: the box is cut there and its value renormalised to the rest.
-  const double bx0 = std::max(0.0, double(p.x) - h), bx1 = std::min(1.0, double(p.x) + h);
-  const double width = bx1 - bx0;
-  if (!(width > 0)) {
-    splat(p, value);
-    return;
-  }
-  const double perArea = value / (width * side);
-  // phi wraps around: a box crossing v = 0 or 1 continues on the other side (side <= 1/2).
-  const double by0 = double(p.y) - h, by1 = double(p.y) + h;
-  if (by0 < 0.0) {
-    splatBoxInto(0, 0.0, 0.0, 1.0, bx0, bx1, by0 + 1.0, 1.0, perArea);
-    splatBoxInto(0, 0.0, 0.0, 1.0, bx0, bx1, 0.0, by1, perArea);
-  } else if (by1 > 1.0) {
-    splatBoxInto(0, 0.0, 0.0, 1.0, bx0, bx1, by0, 1.0, perArea);
-    splatBoxInto(0, 0.0, 0.0, 1.0, bx0, bx1, 0.0, by1 - 1.0, perArea);
-  } else {
-    splatBoxInto(0, 0.0, 0.0, 1.0, bx0, bx1, by0, by1, perArea);
-  }
+  for (int i = 0; i < box.parts; ++i) splatBoxInto(0, 0.0, 0.0, 1.0, box.x0, box.x1, box.y0[i], box.y1[i], box.perArea);
 }
 
 // Adds valuePerArea x (the overlap of the box [bx0, bx1] x [by0, by1] with each child cell of
@@ -70,24 +102,11 @@ void DirTree::splatBoxInto(std::uint32_t node, double x0, double y0, double size
 }
 
 double DirTree::pdfWithout(glm::vec2 p, glm::vec2 q, double side, double value) const {
-  // The splat's share of a cell [x0, x0 + s) x [y0, y0 + s): splatBox's arithmetic.
-  const double h = 0.5 * side;
-  const double bx0 = std::max(0.0, double(q.x) - h), bx1 = std::min(1.0, double(q.x) + h);
-  const double width = bx1 - bx0;
-  const double perArea = width > 0 && side > 0 ? value / (width * side) : 0.0;
+  // The splat's share of a cell [x0, x0 + s) x [y0, y0 + s): what splatBox gave it.
+  const SplatBox box(q, side, value);
   auto share = [&](double x0, double y0, double s) {
-    if (!(perArea > 0)) {  // a point splat
-      return (q.x >= x0 && q.x < x0 + s && q.y >= y0 && q.y < y0 + s) ? value : 0.0;
-    }
-    const double ox = std::min(bx1, x0 + s) - std::max(bx0, x0);
-    if (!(ox > 0)) return 0.0;
-    double oy = 0;
-    for (double shift : {-1.0, 0.0, 1.0}) {
-      const double a = double(q.y) - h + shift, b = double(q.y) + h + shift;
-      const double o = std::min(b, y0 + s) - std::max(a, y0);
-      if (o > 0) oy += o;
-    }
-    return perArea * ox * oy;
+    if (box.point) return (q.x >= x0 && q.x < x0 + s && q.y >= y0 && q.y < y0 + s) ? value : 0.0;
+    return box.within(x0, y0, s);
   };
   double pdf = 1.0;
   bool empty = false;

@@ -506,12 +506,14 @@ ImageDifference compareImages(const Image& a, const Image& reference) {
   const size_t n = a.rgb.size();
   if (n == 0) return d;
   // Accumulate in double: a 4K image has 25M values, far past float's exact-sum range.
-  double relSum = 0, sqSum = 0, sumA = 0, sumB = 0, maxAbs = 0;
+  double relSum = 0, sqSum = 0, sumA = 0, sumB = 0, maxAbs = 0, refSum = 0;
   bool nan = false;
+  const bool refVariance = reference.variance.size() == n;
   for (size_t i = 0; i < n; ++i) {
     double x = a.rgb[i], r = reference.rgb[i];
     double diff = x - r;
     relSum += diff * diff / (r * r + 0.01);
+    if (refVariance) refSum += double(reference.variance[i]) / (r * r + 0.01);
     sqSum += diff * diff;
     sumA += x;
     sumB += r;
@@ -523,14 +525,7 @@ ImageDifference compareImages(const Image& a, const Image& reference) {
   d.meanA = sumA / double(n);
   d.meanB = sumB / double(n);
   d.maxAbs = nan ? std::numeric_limits<double>::quiet_NaN() : maxAbs;
-  if (reference.variance.size() == n) {
-    double refSum = 0;
-    for (size_t i = 0; i < n; ++i) {
-      const double r = reference.rgb[i];
-      refSum += double(reference.variance[i]) / (r * r + 0.01);
-    }
-    d.referenceRelMse = refSum / double(n);
-  }
+  if (refVariance) d.referenceRelMse = refSum / double(n);
   return d;
 }
 

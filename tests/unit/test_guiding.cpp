@@ -540,7 +540,8 @@ TEST(Guiding, LeaveOneOutKeepsABoundedSampleOfTheVertices) {
   t.endIteration(1);
   EXPECT_EQ(t.keptVertices(), 0u);
   EXPECT_EQ(t.leafAlphaVertices(0), double(kept));
-  // Many regions: 1000 / regions, not below 10.
+  // The cap is alphaKeptTotal / regions when that is below alphaKeep (and not below alphaKeepMin):
+  // a total of 64 over this one region keeps between 64 and 128.
   s.alphaKeptTotal = 64;
   GuideTree u(glm::vec3(0.0f), glm::vec3(1.0f), s);
   for (int i = 0; i < 10000; ++i) u.observeSelectionAt(0, glm::vec3(0, 0, 1), 1.0, 1.0, 0.1, 0.1, 0.0);

@@ -12,6 +12,8 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include <csignal>
@@ -388,12 +390,19 @@ TEST(ImagePng, WritesTonemappedPng) {
   stbi_image_free(pixels);
 }
 
-TEST(ImageCompare, KnownInputs) {
+// A 2 x 1 image and a reference whose comparison the tests below work out by hand.
+static std::pair<Image, Image> twoPixelImages() {
   Image a, ref;
   a.width = ref.width = 2;
   a.height = ref.height = 1;
   a.rgb = {1, 2, 3, 0, 0, 0};
   ref.rgb = {1, 1, 1, 0, 0, 1};
+  return {a, ref};
+}
+
+TEST(ImageCompare, KnownInputs) {
+  Image a, ref;
+  std::tie(a, ref) = twoPixelImages();
   ImageDifference d = compareImages(a, ref);
   EXPECT_DOUBLE_EQ(d.mse, 1.0);                      // (0 + 1 + 4 + 0 + 0 + 1) / 6
   EXPECT_DOUBLE_EQ(d.relMse, (1 + 4 + 1) / 1.01 / 6);  // every nonzero diff has ref^2 = 1
@@ -444,10 +453,7 @@ TEST(ImageCompare, KnownInputs) {
 // of relMse, and the crop keeping the variance channels.
 TEST(ImageCompare, ReferenceVarianceGivesItsOwnShareOfRelMse) {
   Image a, ref;
-  a.width = ref.width = 2;
-  a.height = ref.height = 1;
-  a.rgb = {1, 2, 3, 0, 0, 0};
-  ref.rgb = {1, 1, 1, 0, 0, 1};
+  std::tie(a, ref) = twoPixelImages();
   EXPECT_EQ(compareImages(a, ref).referenceRelMse, -1.0);  // no variance channels
   ref.variance = {0.5f, 0, 0, 0.25f, 0, 0};
   EXPECT_DOUBLE_EQ(compareImages(a, ref).referenceRelMse, (0.5 / 1.01 + 0.25 / 0.01) / 6);
