@@ -596,11 +596,20 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
     });
     return splats;
   }
-  // In parallel, the same operations per leaf in the same order: 1. every splat's leaf (threads
-  // over path ranges; findLeaf only reads), with the splats per leaf; 2. the leaves shared among
-  // the threads by their splats (largest first, to the least loaded; a fixed rule); 3. each thread
-  // walks all paths in order and applies the splats of its own leaves.
-  std::vector<std::uint32_t> leafOf(std::size_t(paths) * perPath);
+  // In parallel, the same operations per leaf in the same order: 1. threads over path ranges
+  // read the records once (findLeaf only reads the tree) and list each splat with its leaf, in
+  // path order, and count the splats per leaf; 2. the leaves shared among the threads by their
+  // splats (largest first, to the least loaded; a fixed rule); 3. each thread reads the lists of
+  // the ranges in order and applies the splats of its own leaves. The records are read once: a
+  // chunk's records are scattered over a buffer of hundreds of MiB, the lists are dense.
+  struct Listed {
+    glm::vec3 d;
+    float bw;  // the record's b.w: the splat's value is after / bw
+    glm::vec3 selection;
+    std::uint32_t leaf;
+    double after;
+  };
+  std::vector<std::vector<Listed>> lists(t);
   std::vector<std::vector<std::uint64_t>> counts(t, std::vector<std::uint64_t>(tree.leafCount(), 0));
   auto run = [&](auto&& body) {
     std::vector<std::thread> pool;
@@ -610,9 +619,10 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
   };
   run([&](unsigned i) {
     const std::uint32_t p0 = std::uint32_t(std::uint64_t(paths) * i / t), p1 = std::uint32_t(std::uint64_t(paths) * (i + 1) / t);
-    forEachSplat(p0, p1, [&](std::uint32_t p, std::uint32_t k, glm::vec4 a, glm::vec4, glm::vec4 c, double) {
+    lists[i].reserve(std::size_t(p1 - p0) * 4);
+    forEachSplat(p0, p1, [&](std::uint32_t, std::uint32_t, glm::vec4 a, glm::vec4 b, glm::vec4 c, double after) {
       const std::uint32_t leaf = tree.findLeaf(glm::vec3(a), std::uint32_t(c.w));
-      leafOf[std::size_t(p) * perPath + k] = leaf;
+      lists[i].push_back({glm::vec3(b), b.w, glm::vec3(c), leaf, after});
       ++counts[i][leaf];
     });
   });
@@ -630,18 +640,17 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
     owner[l] = i;
     load[i] += n;
   }
-  std::vector<std::uint64_t> splats(t, 0);
   run([&](unsigned i) {
-    forEachSplat(0, paths, [&](std::uint32_t p, std::uint32_t k, glm::vec4, glm::vec4 b, glm::vec4 c, double after) {
-      const std::uint32_t leaf = leafOf[std::size_t(p) * perPath + k];
-      if (owner[leaf] != i) return;
-      tree.splatInLeaf(leaf, glm::vec3(b), after / double(b.w));
-      if (c.x >= 0.0f) tree.observeSelectionAt(leaf, glm::vec3(b), after / double(b.w), after, c.x, c.y, c.z);
-      ++splats[i];
-    });
+    for (const std::vector<Listed>& list : lists)
+      for (const Listed& e : list) {
+        if (owner[e.leaf] != i) continue;
+        tree.splatInLeaf(e.leaf, e.d, e.after / double(e.bw));
+        if (e.selection.x >= 0.0f)
+          tree.observeSelectionAt(e.leaf, e.d, e.after / double(e.bw), e.after, e.selection.x, e.selection.y, e.selection.z);
+      }
   });
   std::uint64_t total = 0;
-  for (std::uint64_t n : splats) total += n;
+  for (const std::vector<Listed>& list : lists) total += list.size();
   tree.addSplats(total);
   return total;
 }
