@@ -30,6 +30,9 @@
 # reference's); printed beside the raw figure, with the ratios of both. The noise of a 4096-spp
 # reference is several % of a 10 s unguided run's relMSE and a larger share of a guided run's: the
 # raw ratios understate the gains (and the losses).
+# REGIONS ("NAME:x0,y0,x1,y1 ...", NAME a scene's name as printed; default the glass box's caustic
+# under the sphere, "cornell-glass:0.40,0.80,0.60,0.90"): for those scenes each run is also compared
+# in that part of the image (`nusselt diff --region`), with its medians and ratio.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=${1:-/tmp/nusselt-bench-guiding}
@@ -50,6 +53,16 @@ if [ -n "$budget" ]; then
   awk -v t="$budget" 'BEGIN { exit !(t > 0) }' || { echo "TIME=$budget is not a positive number of seconds" >&2; exit 2; }
 fi
 
+
+regions=${REGIONS-"cornell-glass:0.40,0.80,0.60,0.90"}
+# The region of scene $1 (empty: none).
+scene_region() {
+  local r
+  for r in $regions; do
+    if [ "${r%%:*}" = "$1" ]; then echo "${r#*:}"; return 0; fi
+  done
+  return 0
+}
 
 IFS='|' read -r -a variants <<< "${VARIANTS:-}"
 [ ${#variants[@]} -eq 0 ] && variants=("")
@@ -114,11 +127,20 @@ for scene in $scenes; do
         echo "warning: $out: its relMSE $rel is not above the reference's own noise (relMSE less it: $net):" \
           "the figures less the reference's noise mean nothing here; render the reference with more REF_SPP" >&2
       fi
+      region=$(scene_region "$name")
+      regionNet=-
+      if [ -n "$region" ]; then
+        dr=$("$bin" diff "$out" "$ref" --region "$region")
+        regionNet=$(echo "$dr" | awk 'NR == 2 {print $NF}')
+        [ -n "$regionNet" ] || regionNet=$(echo "$dr" | awk 'NR == 1 {print $2}')
+      fi
       prod=$(calc "$rel * $sec")
       got=$("$bin" info "$out" | awk '$1 == "nusselt/spp:" {print $2}')
       printf "%-20s guiding %-3s seed %d: relMSE %.5g (less the reference's noise %.5g)  %.2f s  relMSE x s %.5g  %s spp  (load %s)\n" \
         "$name" "$mode" "$r" "$rel" "$net" "$sec" "$prod" "$got" "$(cut -d' ' -f1 /proc/loadavg)"
-      echo "$rel $sec $prod $got $net" >> "$dir/$name.$mode"
+      [ "$regionNet" = - ] || printf "%-20s guiding %-3s seed %d: region %s: relMSE less the reference's noise %.5g\n" \
+        "$name" "$mode" "$r" "$region" "$regionNet"
+      echo "$rel $sec $prod $got $net $regionNet" >> "$dir/$name.$mode"
     done
   done
   for mode in "${modes[@]}"; do
@@ -133,6 +155,8 @@ for scene in $scenes; do
     read -r nm nse < <(awk '{print $5}' "$dir/$name.$mode" | mean_se)
     printf "%-20s guiding %-3s mean:   relMSE %.5g +- %.2g (less the reference's noise %.5g +- %.2g)\n" "$name" "$mode" \
       "$mm" "$se" "$nm" "$nse"
+    mreg=$(awk '{print $6}' "$dir/$name.$mode" | median)
+    eval "g_$mode=$mreg"
     eval "n_$mode=$mn"
     eval "nm_$mode=$nm"
     eval "m_$mode=$mm"
@@ -149,5 +173,9 @@ for scene in $scenes; do
       "$(calc "$r_off / ${!rOn}")" "$(calc "$p_off / ${!pOn}")" "$(calc "$m_off / ${!mOn}")"
     printf "%-20s   less the reference's noise: relMSE %.3fx, means %.3fx\n" "$name" \
       "$(calc "$n_off / ${!nOn}")" "$(calc "$nm_off / ${!nmOn}")"
+    gOn=g_$mode
+    region=$(scene_region "$name")
+    [ -z "$region" ] || printf "%-20s   region %s, less the reference's noise: medians %.5g / %.5g, relMSE %.3fx\n" "$name" \
+      "$region" "$g_off" "${!gOn}" "$(calc "$g_off / ${!gOn}")"
   done
 done
