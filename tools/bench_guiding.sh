@@ -32,7 +32,7 @@
 # raw ratios understate the gains (and the losses).
 # REGIONS ("NAME:x0,y0,x1,y1 ...", NAME a scene's name as printed; default the glass box's caustic
 # under the sphere, "cornell-glass:0.40,0.80,0.60,0.90"): for those scenes each run is also compared
-# in that part of the image (`nusselt diff --region`), with its medians and ratio.
+# in that part of the image (`nusselt diff --region`), with its medians and ratio; REGIONS= for none.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=${1:-/tmp/nusselt-bench-guiding}
