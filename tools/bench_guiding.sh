@@ -54,6 +54,9 @@ if [ -n "$budget" ]; then
 fi
 
 
+# `nusselt diff ARGS`'s relMSE and its relMSE less the reference's noise (the raw figure again
+# when the reference has no var channels): "RAW NET".
+diff_relmse() { "$bin" diff "$@" | awk 'NR == 1 {r = $2} NR == 2 {n = $NF} END {print r, (n == "" ? r : n)}'; }
 regions=${REGIONS-"cornell-glass:0.40,0.80,0.60,0.90"}
 # The region of scene $1 (empty: none).
 scene_region() {
@@ -98,6 +101,7 @@ echo "device: $("$bin" devices | head -1)"
 for scene in $scenes; do
   name=$(scene_name "$scene")
   sceneArg=$(scene_arg "$scene")
+  region=$(scene_region "$name")
   ref="$dir/$name-ref-$size-$refSpp-$depth-pcg-var.exr"
   # shellcheck disable=SC2086
   bench_reference "$bin" "$scene" "$ref" "$refSpp" $common --rng pcg --variance
@@ -119,21 +123,14 @@ for scene in $scenes; do
       "$run" render $sceneArg $common --spp "$spp" ${budget:+--time "$budget"} --seed "$r" --guiding "$guiding" $extra -o "$out"
       t1=$(date +%s.%N)
       sec=$(echo "$t1 - $t0" | bc -l)
-      d=$("$bin" diff "$out" "$ref")
-      rel=$(echo "$d" | awk 'NR == 1 {print $2}')
-      net=$(echo "$d" | awk 'NR == 2 {print $NF}')  # less the reference's noise
-      [ -n "$net" ] || net=$rel
+      read -r rel net < <(diff_relmse "$out" "$ref")  # net: less the reference's noise
+      [ -n "$rel" ] || { echo "bench_guiding: nusselt diff $out $ref failed" >&2; exit 1; }
       if awk -v n="$net" 'BEGIN { exit !(n <= 0) }'; then
         echo "warning: $out: its relMSE $rel is not above the reference's own noise (relMSE less it: $net):" \
           "the figures less the reference's noise mean nothing here; render the reference with more REF_SPP" >&2
       fi
-      region=$(scene_region "$name")
       regionNet=-
-      if [ -n "$region" ]; then
-        dr=$("$bin" diff "$out" "$ref" --region "$region")
-        regionNet=$(echo "$dr" | awk 'NR == 2 {print $NF}')
-        [ -n "$regionNet" ] || regionNet=$(echo "$dr" | awk 'NR == 1 {print $2}')
-      fi
+      [ -z "$region" ] || read -r _ regionNet < <(diff_relmse "$out" "$ref" --region "$region")
       prod=$(calc "$rel * $sec")
       got=$("$bin" info "$out" | awk '$1 == "nusselt/spp:" {print $2}')
       printf "%-20s guiding %-3s seed %d: relMSE %.5g (less the reference's noise %.5g)  %.2f s  relMSE x s %.5g  %s spp  (load %s)\n" \
@@ -174,7 +171,6 @@ for scene in $scenes; do
     printf "%-20s   less the reference's noise: relMSE %.3fx, means %.3fx\n" "$name" \
       "$(calc "$n_off / ${!nOn}")" "$(calc "$nm_off / ${!nmOn}")"
     gOn=g_$mode
-    region=$(scene_region "$name")
     [ -z "$region" ] || printf "%-20s   region %s, less the reference's noise: medians %.5g / %.5g, relMSE %.3fx\n" "$name" \
       "$region" "$g_off" "${!gOn}" "$(calc "$g_off / ${!gOn}")"
   done

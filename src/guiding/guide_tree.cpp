@@ -589,9 +589,10 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
     forEachSplat(0, paths, [&](std::uint32_t, std::uint32_t, glm::vec4 a, glm::vec4 b, glm::vec4 c, double after) {
       const std::uint32_t o = std::uint32_t(c.w);
       const std::uint32_t leaf = tree.findLeaf(glm::vec3(a), o);
-      tree.splatAt(leaf, glm::vec3(a), o, glm::vec3(b), after / double(b.w));
+      const double value = after / double(b.w);
+      tree.splatAt(leaf, glm::vec3(a), o, glm::vec3(b), value);
       // The same radiance is the vertex's estimate through its sample (y = F / p_mix).
-      if (c.x >= 0.0f) tree.observeSelectionAt(leaf, glm::vec3(b), after / double(b.w), after, c.x, c.y, c.z);
+      if (c.x >= 0.0f) tree.observeSelectionAt(leaf, glm::vec3(b), value, after, c.x, c.y, c.z);
       ++splats;
     });
     return splats;
@@ -644,9 +645,10 @@ std::uint64_t splatPaths(GuideTree& tree, const glm::vec4* records, std::uint32_
     for (const std::vector<Listed>& list : lists)
       for (const Listed& e : list) {
         if (owner[e.leaf] != i) continue;
-        tree.splatInLeaf(e.leaf, e.d, e.after / double(e.bw));
+        const double value = e.after / double(e.bw);
+        tree.splatInLeaf(e.leaf, e.d, value);
         if (e.selection.x >= 0.0f)
-          tree.observeSelectionAt(e.leaf, e.d, e.after / double(e.bw), e.after, e.selection.x, e.selection.y, e.selection.z);
+          tree.observeSelectionAt(e.leaf, e.d, value, e.after, e.selection.x, e.selection.y, e.selection.z);
       }
   });
   std::uint64_t total = 0;
