@@ -29,7 +29,9 @@
 # reference's own noise (for a run independent of it, E[relMSE] = the run's error + the
 # reference's); printed beside the raw figure, with the ratios of both. The noise of a 4096-spp
 # reference is several % of a 10 s unguided run's relMSE and a larger share of a guided run's: the
-# raw ratios understate the gains (and the losses).
+# raw ratios understate the gains (and the losses). A warning says when the reference's noise is
+# above a run's error less it (a 4096-spp reference against 60 s runs at 256 x 256): the figures
+# less it then rest on its var channels, and a reference with more REF_SPP is the remedy.
 # REGIONS ("NAME:x0,y0,x1,y1 ...", NAME a scene's name as printed; default the glass box's caustic
 # under the sphere, "cornell-glass:0.40,0.80,0.60,0.90"): for those scenes each run is also compared
 # in that part of the image (`nusselt diff --region`), with its medians and ratio; REGIONS= for none.
@@ -128,6 +130,11 @@ for scene in $scenes; do
       if awk -v n="$net" 'BEGIN { exit !(n <= 0) }'; then
         echo "warning: $out: its relMSE $rel is not above the reference's own noise (relMSE less it: $net):" \
           "the figures less the reference's noise mean nothing here; render the reference with more REF_SPP" >&2
+      elif awk -v r="$rel" -v n="$net" 'BEGIN { exit !(r - n > n) }'; then
+        # The subtraction then carries more than the run's own error: a few % off in the
+        # reference's var channels moves the figure by more than that.
+        echo "warning: $out: the reference's own noise ($(calc "$rel - $net")) is above this run's error less it" \
+          "($net): the figures less the reference's noise rest on its var channels; render the reference with more REF_SPP" >&2
       fi
       regionNet=-
       [ -z "$region" ] || read -r _ regionNet < <(diff_relmse "$out" "$ref" --region "$region")
