@@ -15,6 +15,9 @@
   combined.gltf  combined materials (NUSSELT_brdf components) in a small coloured box under an
                  area light: lambert + phong + mirror, lambert + dielectric, a saturated lambert
                  + a white phong; for renders that exercise every combined-material code path.
+  combined_indirect.gltf  the same box with its light lowered to y = 1.7 and turned to face the
+                 ceiling (lit only indirectly, as scenes/cornell/cornell-indirect.glb): where path
+                 guiding pays, on combined materials (tools/bench_guiding.sh).
   textures.gltf  glTF textures as the renderer applies them (docs/scenes.md, "Textures"): a
                  gltf_pbr floor with a baseColor checker (NEAREST, REPEAT, KHR_texture_transform
                  scale 3) and a metallicRoughness gradient (LINEAR, CLAMP_TO_EDGE: roughness
@@ -374,7 +377,7 @@ def punctual():
     b.write("punctual.gltf")
 
 
-def combined():
+def combined(indirect=False):
     b = Builder()
     tile = b.combined_material("tile", [
         {"model": "lambert", "weight": 0.6, "params": {"rho": [0.5, 0.4, 0.3]}},
@@ -393,9 +396,12 @@ def combined():
     b.quad("left", [[-1, 0, 1], [-1, 0, -1], [-1, 2, -1], [-1, 2, 1]], red)
     b.quad("right", [[1, 0, -1], [1, 0, 1], [1, 2, 1], [1, 2, -1]], white)
     b.quad("ceiling", [[-1, 2, -1], [1, 2, -1], [1, 2, 1], [-1, 2, 1]], white)
-    b.quad("light", [[-0.3, 1.99, -0.3], [0.3, 1.99, -0.3], [0.3, 1.99, 0.3], [-0.3, 1.99, 0.3]], light)
+    if indirect:  # facing +y (counter-clockwise seen from above, as the floor)
+        b.quad("light", [[-0.3, 1.7, -0.3], [-0.3, 1.7, 0.3], [0.3, 1.7, 0.3], [0.3, 1.7, -0.3]], light)
+    else:
+        b.quad("light", [[-0.3, 1.99, -0.3], [0.3, 1.99, -0.3], [0.3, 1.99, 0.3], [-0.3, 1.99, 0.3]], light)
     b.camera("camera", (0.0, 1.0, 3.4), (0.0, 1.0, 0.0), 0.8, 1.0)
-    b.write("combined.gltf")
+    b.write("combined_indirect.gltf" if indirect else "combined.gltf")
 
 
 def textures():
@@ -507,6 +513,7 @@ if __name__ == "__main__":
     mis()
     punctual()
     combined()
+    combined(indirect=True)
     environment()
     env_bench(False)
     env_bench(True)

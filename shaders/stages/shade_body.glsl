@@ -364,6 +364,11 @@ struct ShadeMaterial {
   vec4 c;            // MIS probabilities (0 for delta components, which have no MIS density)
   uint mode;         // the choice mode (combinedChoiceMode)
   bool lightSamples; // no delta flag on the material
+  // Path guiding: whether the guide's mixture applies (a non-delta component, none transmitting
+  // with a density, the throughput roulette: the albedo choice's own roulette stays unguided),
+  // and the vertex's region (alpha 0 elsewhere).
+  bool guidable;
+  GuideVertex gv;
 };
 
 // A transmitting non-delta component (rough_dielectric) seen from the inside: its parameters from
@@ -377,6 +382,8 @@ void insideComponent(uint model, inout GpuComponent C) {
 
 // Whether component `model` scatters below the surface with a density (light samples there).
 bool componentTransmits(uint model) { return modelTransmits(model) && !modelIsDelta(model); }
+
+bool shadeTransmits(ShadeMaterial m);
 
 // hit: a textured material's components take the textures at the hit (texturedParams: gltf_pbr's
 // base colour and metallic-roughness, the transmitting models' tint), and the transmission
@@ -447,6 +454,9 @@ ShadeMaterial shadeMaterial(GpuMaterial M, vec3 x, vec3 ng, vec3 wo, uint roulet
   if (modelIsDelta(MODEL_3)) m.c.w = 0.0f;
 #endif
   m.lightSamples = (M.info.y & MATERIAL_DELTA) == 0u;
+  m.guidable = GUIDING && m.lightSamples && roulette != ROULETTE_ALBEDO && !shadeTransmits(m);
+  m.gv = GuideVertex(0u, 0.0f);
+  if (m.guidable) m.gv = guideVertex(x, ng);
   return m;
 }
 
@@ -492,7 +502,13 @@ float shadeMisPdf(ShadeMaterial m, vec3 wo, vec3 wi) {
 
 // The component choice (albedo mode under the albedo roulette: includes the roulette), then the
 // chosen component's sample; factor w_k f_k cos / (P_k pdf_k), with uniform mode's separate albedo
-// roulette (uR) under the albedo roulette. Combined materials are not guided yet.
+// roulette (uR) under the albedo roulette.
+// Guided (m.guidable, in a guided render): the choice as unguided; a delta component chosen samples
+// as unguided (the delta lobes keep their rate), a non-delta one is replaced by the guide with
+// probability alpha (one-sample MIS within the non-delta part, of probability P_nd = sum of the
+// non-delta P_k). A non-delta direction's density is then alpha P_nd p_guide + (1 - alpha) p_bsdf,
+// p_bsdf = sum_k P_k pdf_k over the non-delta components (shadeMisPdf), and its factor the
+// material's whole f cos over it. docs/guiding.md, "Sampling".
 bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo, bool inside, vec3 tt, vec3 bb,
                  vec3 ns, float uR, out PathStep s) {
   s.wiLocal = vec3(0.0f, 0.0f, 1.0f);
@@ -500,11 +516,16 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
   s.pdf = 0.0f;
   s.etaScale = 1.0f;
   s.delta = false;
-  s.selection = vec3(-1.0f, 0.0f, 0.0f);  // combined materials do not sample the guide yet
+  s.selection = vec3(-1.0f, 0.0f, 0.0f);
   float uC = pathSample1(k, rngDimension(bounce, RNG_DIM_COMPONENT));
   uint j;
   float pk;
   if (!combinedPick(m.mode, COMPONENT_COUNT, m.a, uC, j, pk) || !(pk > 0.0f)) return false;
+  vec2 uG = vec2(1.0f);
+  if (GUIDING && m.gv.alpha > 0.0f) uG = pathSample2(k, rngDimension(bounce, RNG_DIM_GUIDE));
+  uint modelJ = j == 0u ? MODEL_0 : (j == 1u ? MODEL_1 : (j == 2u ? MODEL_2 : MODEL_3));
+  bool guided = GUIDING && uG.x < m.gv.alpha && !modelIsDelta(modelJ);
+  if (guided) j = MAX_COMPONENTS;  // no component samples
 
   uint dimB = rngDimension(bounce, RNG_DIM_BSDF);
   vec2 uB = pathSample2(k, dimB);
@@ -544,7 +565,34 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
     etaK = transmissionEtaScale(MODEL_3, m.C3.params, inside);
   }
 #endif
-  if (!ok || !(wk > 0.0f)) return false;
+  if (!guided && (!ok || !(wk > 0.0f))) return false;
+
+  // Training records need both densities wherever the guide could be chosen, also where alpha is
+  // 0 (as single-model materials: GuideTree::observeSelection); with them, the factor of a
+  // non-delta sample is the mixture's (at alpha 0: f cos / p_bsdf, the estimate the densities
+  // describe).
+  bool record = GUIDING && m.guidable && guideRecording();
+  if (GUIDING && !delta && (m.gv.alpha > 0.0f || record)) {
+    vec3 w = guided ? vec3(0.0f) : toWorld(wiLocal, tt, bb, ns);
+    // The guide's share of the density: P_nd p_guide (recorded as the guide's density, so that
+    // the trainer's alpha p_guide + (1 - alpha) p_bsdf is this sample's density).
+    float pdfG = guideDescend(m.gv, guided, uG.y, k, bounce, w) * (m.c.x + m.c.y + m.c.z + m.c.w);
+    if (guided) {
+      if (!(pdfG > 0.0f)) return false;
+      wiLocal = toLocal(w, tt, bb, ns);
+      if (!(wiLocal.z > 0.0f)) return false;  // below the surface, f cos = 0: the path ends
+      etaK = 1.0f;
+    }
+    float pdfB = shadeMisPdf(m, wo, wiLocal);
+    float pdfMix = guideMixturePdf(m.gv.alpha, pdfG, pdfB);
+    if (!(pdfMix > 0.0f)) return false;
+    s.wiLocal = wiLocal;
+    s.factor = shadeEval(m, wiLocal, wo) * (wiLocal.z / pdfMix);
+    s.pdf = pdfMix;
+    s.etaScale = etaK;
+    s.selection = vec3(pdfG, pdfB, m.gv.alpha);
+    return true;
+  }
 
   float p = pk;
   if (roulette == ROULETTE_ALBEDO && m.mode == COMPONENTS_UNIFORM) {

@@ -94,9 +94,55 @@ TEST(Guiding, UnbiasedOnIndirectlyLitCornellBox) {
   expectUnbiased(test::loadTestScene("scenes/cornell/cornell-indirect.glb"), 32, 64, 6, 4, 0.5f, true);
 }
 
-// Combined materials (not guided, they train), mirror and dielectric components (never guided).
+// Combined materials (guided within their non-delta part: a non-delta component chosen is replaced
+// by the guide with probability alpha), with mirror and dielectric components (never guided).
+// At alpha 0.5 every combined vertex of a trained region samples the mixture; 512 spp, so that a
+// missing factor of the mixture's density shows in the image means.
 TEST(Guiding, UnbiasedWithCombinedAndDeltaMaterials) {
   expectUnbiased(test::loadTestScene("scenes/tests/combined.gltf"), 24, 32, 5, 4);
+  expectUnbiased(test::loadTestScene("scenes/tests/combined.gltf"), 32, 512, 5, 4, 0.5f);
+}
+
+// Combined materials' vertices record both densities for the trainer (guiding_layout.h, record
+// c), as single-model ones do: every non-delta sample's record has the guide's density (>= 0; -1
+// marks a vertex that does not sample the mixture) and a positive BRDF-sampler density, and the
+// scene's combined materials (tile, glazed, red_gloss: most of the box) give many of them.
+TEST(Guiding, CombinedMaterialsRecordTheMixturesDensities) {
+  Scene scene = test::loadTestScene("scenes/tests/combined.gltf");
+  std::uint32_t combined = 0;
+  for (const Material& m : scene.materials) combined += m.combined() ? 1u : 0u;
+  ASSERT_EQ(combined, 3u);
+  RenderSettings s;
+  s.width = s.height = 16;
+  s.spp = 1;
+  s.maxDepth = 5;
+  s.seed = 7;
+  s.guiding = true;
+  s.guideTrainSpp = 1;  // one pass, iteration 0: its records stay in the buffer
+  const std::uint32_t paths = s.width * s.height;
+  const std::size_t vec4s = std::size_t(paths) * DeviceGuide::recordsPerPath(s.maxDepth) * GUIDE_RECORD_VEC4S;
+  Renderer r(test::context(), scene, s);
+  r.render(s.spp);
+  std::vector<glm::vec4> v(vec4s);
+  vk::downloadBuffer(test::context(), r.guide()->records(), v.data(), vec4s * sizeof(glm::vec4));
+  std::uint32_t nonDelta = 0, delta = 0;
+  for (std::uint32_t p = 0; p < paths; ++p)
+    for (std::uint32_t k = 0; k + 1 < DeviceGuide::recordsPerPath(s.maxDepth); ++k) {
+      const std::size_t i = shared::guideRecordIndex(p, k, paths);
+      const float b = v[i + 1].w;
+      if (b == 0.0f) break;  // the path ended here
+      if (b < 0.0f) {        // a delta sample (or one without luminance): not splatted
+        ++delta;
+        continue;
+      }
+      ++nonDelta;
+      EXPECT_GE(v[i + 2].x, 0.0f) << "path " << p << " vertex " << k << ": no guide density recorded";
+      EXPECT_GT(v[i + 2].y, 0.0f) << "path " << p << " vertex " << k;
+    }
+  std::printf("%u non-delta and %u delta records\n", nonDelta, delta);
+  EXPECT_GT(nonDelta, paths);
+  EXPECT_GT(delta, 0u);
+  EXPECT_EQ(test::validationMessages(), 0u);
 }
 
 // An environment (the escape stage writes the records of rays that leave the scene), a Lambert
