@@ -81,6 +81,27 @@ void expectUnbiased(const Scene& scene, std::uint32_t size, std::uint32_t spp, s
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
+// The training records (guiding_layout.h) of a guided render of kRecordPaths pixels, one sample
+// each (seed 7, depth kRecordDepth): one pass, iteration 0, whose records stay in the buffer.
+// product: what the records carry (RenderSettings::guideProduct).
+constexpr std::uint32_t kRecordSide = 16, kRecordPaths = kRecordSide * kRecordSide, kRecordDepth = 5;
+std::vector<glm::vec4> firstPassRecords(const Scene& scene, bool product = true) {
+  RenderSettings s;
+  s.width = s.height = kRecordSide;
+  s.spp = 1;
+  s.maxDepth = kRecordDepth;
+  s.seed = 7;
+  s.guiding = true;
+  s.guideTrainSpp = 1;
+  s.guideProduct = product;
+  const std::size_t vec4s = std::size_t(kRecordPaths) * DeviceGuide::recordsPerPath(kRecordDepth) * GUIDE_RECORD_VEC4S;
+  Renderer r(test::context(), scene, s);
+  r.render(s.spp);
+  std::vector<glm::vec4> v(vec4s);
+  vk::downloadBuffer(test::context(), r.guide()->records(), v.data(), vec4s * sizeof(glm::vec4));
+  return v;
+}
+
 }  // namespace
 
 // The Cornell box lit only indirectly (its light faces the ceiling): guiding's home ground.
@@ -112,23 +133,11 @@ TEST(Guiding, CombinedMaterialsRecordTheMixturesDensities) {
   std::uint32_t combined = 0;
   for (const Material& m : scene.materials) combined += m.combined() ? 1u : 0u;
   ASSERT_EQ(combined, 3u);
-  RenderSettings s;
-  s.width = s.height = 16;
-  s.spp = 1;
-  s.maxDepth = 5;
-  s.seed = 7;
-  s.guiding = true;
-  s.guideTrainSpp = 1;  // one pass, iteration 0: its records stay in the buffer
-  const std::uint32_t paths = s.width * s.height;
-  const std::size_t vec4s = std::size_t(paths) * DeviceGuide::recordsPerPath(s.maxDepth) * GUIDE_RECORD_VEC4S;
-  Renderer r(test::context(), scene, s);
-  r.render(s.spp);
-  std::vector<glm::vec4> v(vec4s);
-  vk::downloadBuffer(test::context(), r.guide()->records(), v.data(), vec4s * sizeof(glm::vec4));
+  const std::vector<glm::vec4> v = firstPassRecords(scene);
   std::uint32_t nonDelta = 0, delta = 0;
-  for (std::uint32_t p = 0; p < paths; ++p)
-    for (std::uint32_t k = 0; k + 1 < DeviceGuide::recordsPerPath(s.maxDepth); ++k) {
-      const std::size_t i = shared::guideRecordIndex(p, k, paths);
+  for (std::uint32_t p = 0; p < kRecordPaths; ++p)
+    for (std::uint32_t k = 0; k + 1 < DeviceGuide::recordsPerPath(kRecordDepth); ++k) {
+      const std::size_t i = shared::guideRecordIndex(p, k, kRecordPaths);
       const float b = v[i + 1].w;
       if (b == 0.0f) break;  // the path ended here
       if (b < 0.0f) {        // a delta sample (or one without luminance): not splatted
@@ -140,7 +149,7 @@ TEST(Guiding, CombinedMaterialsRecordTheMixturesDensities) {
       EXPECT_GT(v[i + 2].y, 0.0f) << "path " << p << " vertex " << k;
     }
   std::printf("%u non-delta and %u delta records\n", nonDelta, delta);
-  EXPECT_GT(nonDelta, paths);
+  EXPECT_GT(nonDelta, kRecordPaths);
   EXPECT_GT(delta, 0u);
   EXPECT_EQ(test::validationMessages(), 0u);
 }
@@ -282,28 +291,11 @@ TEST(Guiding, ProductRecordsCarryTheBsdfAndCosine) {
     ASSERT_EQ(m.model, MODEL_LAMBERT);
     rhos.push_back(shared::luminance(shared::brdfParam3(m.params, LAMBERT_RHO)));
   }
-  RenderSettings s;
-  s.width = s.height = 16;
-  s.spp = 1;
-  s.maxDepth = 5;
-  s.seed = 7;
-  s.guiding = true;
-  s.guideTrainSpp = 1;  // one pass, iteration 0: its records stay in the buffer
-  const std::uint32_t paths = s.width * s.height;
-  const std::size_t vec4s = std::size_t(paths) * DeviceGuide::recordsPerPath(s.maxDepth) * GUIDE_RECORD_VEC4S;
-  auto records = [&](bool product) {
-    s.guideProduct = product;
-    Renderer r(test::context(), scene, s);
-    r.render(s.spp);
-    std::vector<glm::vec4> v(vec4s);
-    vk::downloadBuffer(test::context(), r.guide()->records(), v.data(), vec4s * sizeof(glm::vec4));
-    return v;
-  };
-  const std::vector<glm::vec4> rad = records(false), prod = records(true);
+  const std::vector<glm::vec4> rad = firstPassRecords(scene, false), prod = firstPassRecords(scene, true);
   std::uint32_t checked = 0;
-  for (std::uint32_t p = 0; p < paths; ++p) {
-    for (std::uint32_t k = 0; k + 1 < DeviceGuide::recordsPerPath(s.maxDepth); ++k) {
-      const std::size_t i = shared::guideRecordIndex(p, k, paths);
+  for (std::uint32_t p = 0; p < kRecordPaths; ++p) {
+    for (std::uint32_t k = 0; k + 1 < DeviceGuide::recordsPerPath(kRecordDepth); ++k) {
+      const std::size_t i = shared::guideRecordIndex(p, k, kRecordPaths);
       ASSERT_EQ(0, std::memcmp(&rad[i], &prod[i], sizeof(glm::vec4))) << "path " << p << " vertex " << k;
       ASSERT_EQ(0, std::memcmp(&rad[i + 2], &prod[i + 2], sizeof(glm::vec4))) << "path " << p << " vertex " << k;
       const float bR = rad[i + 1].w, bP = prod[i + 1].w;
@@ -319,7 +311,7 @@ TEST(Guiding, ProductRecordsCarryTheBsdfAndCosine) {
     }
   }
   std::printf("%u records checked\n", checked);
-  EXPECT_GT(checked, paths);  // most paths bounce more than once
+  EXPECT_GT(checked, kRecordPaths);  // most paths bounce more than once
   EXPECT_EQ(test::validationMessages(), 0u);
 }
 
