@@ -225,6 +225,20 @@ struct PathStep {
   vec3 selection;
 };
 
+// The guide's side of a sample at a vertex of region gv (guiding.h, guideDescend), for both kinds of
+// material: guided, the direction drawn from the guide, into wiLocal (false, the path ends: the
+// region has no mass there, or the direction is below the surface, where f cos = 0); otherwise the
+// guide's density at wiLocal, the material's own sample. pdfG: the guide's density per steradian.
+bool guideSide(GuideVertex gv, bool guided, float uDescent, PathKey k, uint bounce, vec3 tt, vec3 bb, vec3 ns,
+               inout vec3 wiLocal, out float pdfG) {
+  vec3 w = guided ? vec3(0.0f) : toWorld(wiLocal, tt, bb, ns);
+  pdfG = guideDescend(gv, guided, uDescent, k, bounce, w);
+  if (!guided) return true;
+  if (!(pdfG > 0.0f)) return false;
+  wiLocal = toLocal(w, tt, bb, ns);
+  return wiLocal.z > 0.0f;
+}
+
 // ---- The material at a hit: one interface, two implementations ----
 // ShadeMaterial      what the material needs at this hit (set up once by shadeMaterial)
 // shadeLightSamples  whether next-event estimation applies (not for delta materials)
@@ -322,12 +336,9 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
   if (GUIDING && (m.gv.alpha > 0.0f || record)) {
     // One descent of the guide's tree for every lane: a guided lane draws its direction, the
     // others look up the guide's density at their BSDF sample (guiding.h, guideDescend).
-    vec3 w = guided ? vec3(0.0f) : toWorld(wiLocal, tt, bb, ns);
-    float pdfG = guideDescend(m.gv, guided, uG.y, k, bounce, w);
+    float pdfG;
+    if (!guideSide(m.gv, guided, uG.y, k, bounce, tt, bb, ns, wiLocal, pdfG)) return false;
     if (guided) {
-      if (!(pdfG > 0.0f)) return false;
-      wiLocal = toLocal(w, tt, bb, ns);
-      if (!(wiLocal.z > 0.0f)) return false;  // below the surface, f cos = 0: the path ends
       weight = brdfEval(MODEL_ID, m.M.params, wiLocal, wo) * wiLocal.z;  // f cos, over the mixture below
       pdf = 1.0f;
       q = 1.0f;
@@ -573,16 +584,12 @@ bool shadeSample(ShadeMaterial m, PathKey k, uint bounce, uint roulette, vec3 wo
   // describe).
   bool record = GUIDING && m.guidable && guideRecording();
   if (GUIDING && !delta && (m.gv.alpha > 0.0f || record)) {
-    vec3 w = guided ? vec3(0.0f) : toWorld(wiLocal, tt, bb, ns);
+    float pdfG;
+    if (!guideSide(m.gv, guided, uG.y, k, bounce, tt, bb, ns, wiLocal, pdfG)) return false;
     // The guide's share of the density: P_nd p_guide (recorded as the guide's density, so that
     // the trainer's alpha p_guide + (1 - alpha) p_bsdf is this sample's density).
-    float pdfG = guideDescend(m.gv, guided, uG.y, k, bounce, w) * (m.c.x + m.c.y + m.c.z + m.c.w);
-    if (guided) {
-      if (!(pdfG > 0.0f)) return false;
-      wiLocal = toLocal(w, tt, bb, ns);
-      if (!(wiLocal.z > 0.0f)) return false;  // below the surface, f cos = 0: the path ends
-      etaK = 1.0f;
-    }
+    pdfG *= m.c.x + m.c.y + m.c.z + m.c.w;
+    if (guided) etaK = 1.0f;
     float pdfB = shadeMisPdf(m, wo, wiLocal);
     float pdfMix = guideMixturePdf(m.gv.alpha, pdfG, pdfB);
     if (!(pdfMix > 0.0f)) return false;
